@@ -1,0 +1,38 @@
+#pragma once
+// Pieces shared by the oobleck subcommands: parameter selection (--preset/--params), plotting
+// through matplotlib scripts in tools/, and number formatting for CSV/JSON.
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "oobleck/rheology/params.hpp"
+
+namespace oobleck::cli {
+
+/// Adds --preset NAME and --params FILE (mutually exclusive) to `cmd`.
+struct ParamsOption {
+  std::string preset;
+  std::string params;
+  void add_to(CLI::App* cmd);
+  /// Loads and validates the chosen set. Falls back to `fallback_preset` when neither is given
+  /// and fallback_preset is not empty.
+  rheology::Preset load(const std::string& fallback_preset = "") const;
+};
+
+/// Python interpreter with matplotlib: $OOBLECK_PYTHON, else /usr/bin/python3.
+std::string python();
+/// Folder of the plotting scripts.
+std::string tools_dir();
+/// Run tools/<script> with arguments; throws NumericalError if the script fails.
+void run_tool(const std::string& script, const std::vector<std::string>& args);
+
+/// Shortest round-trip representation of a double ("17 significant digits").
+std::string num(double v);
+
+/// Register subcommands (one file per command group).
+void add_rheology_commands(CLI::App& app);
+void add_fit_command(CLI::App& rheology);
+void add_point_commands(CLI::App& app);
+
+}  // namespace oobleck::cli

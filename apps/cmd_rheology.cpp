@@ -1,0 +1,179 @@
+// `oobleck rheology ...`: steady rheology of the model (model.md §2): flow curves with every
+// branch, the DST shear rate, the f(tau) comparison and the mass-to-volume fraction conversion.
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "cli_common.hpp"
+#include "oobleck/core/error.hpp"
+#include "oobleck/io/output_file.hpp"
+#include "oobleck/rheology/flow_curve.hpp"
+#include "oobleck/rheology/structure_evolution.hpp"
+#include "oobleck/rheology/volume_fraction.hpp"
+
+namespace oobleck::cli {
+namespace {
+
+/// Run a plotting script that writes `png`, atomically: the script writes a temporary file that
+/// is renamed only when it succeeds.
+void plot(const std::string& script, std::vector<std::string> args, const std::string& png) {
+  const std::string tmp = png + ".tmp.png";
+  args.push_back(tmp);
+  try {
+    run_tool(script, args);
+  } catch (...) {
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    throw;
+  }
+  std::filesystem::rename(tmp, png);
+}
+
+void flow_curve_command(CLI::App& rheology) {
+  auto* cmd = rheology.add_subcommand("flow-curve", "steady flow curves tau(gamma_dot) with every branch (E11)");
+  struct Opts {
+    ParamsOption params;
+    std::vector<double> phi;
+    int points = 400;
+    std::string out, png;
+  };
+  auto o = std::make_shared<Opts>();
+  o->params.add_to(cmd);
+  cmd->add_option("--phi", o->phi, "volume fraction(s), 0 < phi < phi_j (repeat for several)")->required();
+  cmd->add_option("--points", o->points, "points per curve (>= 2)")->capture_default_str();
+  cmd->add_option("--out", o->out, "output CSV file")->required();
+  cmd->add_option("--plot", o->png, "also plot tau vs gamma_dot to this PNG");
+  cmd->callback([o] {
+    const rheology::Preset p = o->params.load();
+    if (o->points < 2) throw InputError(fmt::format("--points = {}: must be >= 2", o->points));
+    for (double phi : o->phi) rheology::validate_phi(p.steady, phi, fmt::format("--phi (parameters: {})", p.file));
+    io::check_writable(o->out, "--out");
+    if (!o->png.empty()) io::check_writable(o->png, "--plot");
+
+    io::OutputFile csv(o->out, "--out");
+    auto& s = csv.stream();
+    s << "phi,f,shear_rate,shear_stress,granular_pressure,granular_shear_stress,viscosity,eta_r,shear_rate_dst\n";
+    for (double phi : o->phi) {
+      const auto dst = rheology::shear_rate_dst(p.steady, phi);
+      const std::string dst_s = dst ? num(*dst) : "nan";
+      for (const auto& pt : rheology::flow_curve(p.steady, phi, o->points)) {
+        s << fmt::format("{},{},{},{},{},{},{},{},{}\n", num(pt.phi), num(pt.f), num(pt.shear_rate),
+                         num(pt.shear_stress), num(pt.granular_pressure), num(pt.granular_shear_stress),
+                         num(pt.viscosity), num(pt.eta_r), dst_s);
+      }
+    }
+    csv.commit();
+    fmt::print("wrote {} ({} curves x {} points; parameters {} [{} units])\n", o->out, o->phi.size(), o->points,
+               p.name, p.units);
+    if (!o->png.empty()) {
+      plot("plot_flow_curves.py", {o->out, "--title", fmt::format("{} ({} units)", p.name, p.units)}, o->png);
+      fmt::print("wrote {}\n", o->png);
+    }
+  });
+}
+
+void dst_command(CLI::App& rheology) {
+  auto* cmd = rheology.add_subcommand("dst", "the DST shear rate gamma_dot_DST (E14)");
+  struct Opts {
+    ParamsOption params;
+    double phi = 0.0;
+    bool json = false;
+  };
+  auto o = std::make_shared<Opts>();
+  o->params.add_to(cmd);
+  cmd->add_option("--phi", o->phi, "volume fraction")->required();
+  cmd->add_flag("--json", o->json, "print one JSON object {\"phi\", \"shear_rate_dst\"}");
+  cmd->callback([o] {
+    const rheology::Preset p = o->params.load();
+    rheology::validate_phi(p.steady, o->phi, fmt::format("--phi (parameters: {})", p.file));
+    std::string reason;
+    const auto rate = rheology::shear_rate_dst(p.steady, o->phi, &reason);
+    if (o->json) {
+      nlohmann::json j;
+      j["phi"] = o->phi;
+      j["shear_rate_dst"] = rate ? nlohmann::json(*rate) : nlohmann::json(nullptr);
+      if (!rate) j["reason"] = reason;
+      fmt::print("{}\n", j.dump());
+    } else if (rate) {
+      fmt::print("gamma_dot_DST = {:.6g} 1/s  ({} at phi = {})\n", *rate, p.name, o->phi);
+    } else {
+      fmt::print("no DST at phi = {} for {}: {}\n", o->phi, p.name, reason);
+    }
+  });
+}
+
+void structure_command(CLI::App& rheology) {
+  auto* cmd = rheology.add_subcommand(
+      "structure", "steady f(tau) of this model (eta_B -> infinity) beside Wyart–Cates and Singh et al.");
+  struct Opts {
+    ParamsOption params;
+    int points = 200;
+    std::string out, png;
+  };
+  auto o = std::make_shared<Opts>();
+  o->params.add_to(cmd);
+  cmd->add_option("--points", o->points, "number of stresses (log-spaced over 1e-3..1e3 tau*)")->capture_default_str();
+  cmd->add_option("--out", o->out, "output CSV file")->required();
+  cmd->add_option("--plot", o->png, "also plot to this PNG");
+  cmd->callback([o] {
+    const rheology::Preset p = o->params.load();
+    if (o->points < 2) throw InputError(fmt::format("--points = {}: must be >= 2", o->points));
+    io::check_writable(o->out, "--out");
+    if (!o->png.empty()) io::check_writable(o->png, "--plot");
+    io::OutputFile csv(o->out, "--out");
+    csv.stream() << "stress,f_model,f_wyart_cates,f_singh\n";
+    const double ts = p.steady.tau_star;
+    for (int k = 0; k < o->points; ++k) {
+      const double tau = ts * std::pow(10.0, -3.0 + 6.0 * k / (o->points - 1));
+      const double H = rheology::hardening(tau, ts);       // E7 with tau_bar ~ tau
+      const double f_model = rheology::steady_f(H, 1.0, 1.0);  // E10, S = 1 (eta_B -> inf), f_m = 1
+      csv.stream() << fmt::format("{},{},{},{}\n", num(tau), num(f_model), num(1.0 - std::exp(-tau / ts)),
+                                  num(std::exp(-ts / tau)));
+    }
+    csv.commit();
+    fmt::print("wrote {}\n", o->out);
+    if (!o->png.empty()) {
+      plot("plot_structure.py", {o->out, "--tau-star", num(ts), "--title", p.name}, o->png);
+      fmt::print("wrote {}\n", o->png);
+    }
+  });
+}
+
+void volume_fraction_command(CLI::App& rheology) {
+  auto* cmd = rheology.add_subcommand("volume-fraction", "phi from the mass fraction of swelling starch (E15)");
+  auto in = std::make_shared<rheology::MassFractionInput>();
+  auto json = std::make_shared<bool>(false);
+  cmd->add_option("--mass-fraction", in->mass_fraction, "phi_W = m_cs/(m_cs + m_l)")->required();
+  cmd->add_option("--rho-cs", in->rho_cs, "cornstarch grain density [kg/m^3]")->required();
+  cmd->add_option("--rho-liquid", in->rho_liquid, "suspending liquid density [kg/m^3]")->required();
+  cmd->add_option("--rho-water", in->rho_water, "water density [kg/m^3]")->required();
+  cmd->add_option("--lambda", in->lambda, "pore-space correction")->capture_default_str();
+  cmd->add_option("--beta", in->beta, "swelling correction")->capture_default_str();
+  cmd->add_flag("--json", *json, "print a JSON object");
+  cmd->callback([in, json] {
+    rheology::validate_mass_fraction_input(*in);
+    const double phi = rheology::volume_fraction(*in);
+    if (*json) {
+      fmt::print("{}\n", nlohmann::json{{"mass_fraction", in->mass_fraction}, {"phi", phi}}.dump());
+    } else {
+      fmt::print("phi = {:.6f}\n", phi);
+    }
+  });
+}
+
+}  // namespace
+
+void add_rheology_commands(CLI::App& app) {
+  auto* rheology = app.add_subcommand("rheology", "steady rheology: flow curves, DST, fitting");
+  rheology->require_subcommand(1);
+  flow_curve_command(*rheology);
+  dst_command(*rheology);
+  structure_command(*rheology);
+  volume_fraction_command(*rheology);
+  add_fit_command(*rheology);
+}
+
+}  // namespace oobleck::cli

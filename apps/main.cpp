@@ -1,0 +1,33 @@
+// oobleck: simulator for dense, fine-particle suspensions (Baumgarten & Kamrin 2019).
+// Exit status: 0 success, 1 usage error, 2 bad input (file/key/value named), 3 numerical failure.
+#include <cstdio>
+#include <exception>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "cli_common.hpp"
+#include "oobleck/core/error.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"oobleck — dense suspension simulator (Baumgarten–Kamrin 2019 model)"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "oobleck 0.1.0");
+  oobleck::cli::add_rheology_commands(app);
+  oobleck::cli::add_point_commands(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const oobleck::InputError& e) {
+    fmt::print(stderr, "oobleck: error: {}\n", e.what());
+    return 2;
+  } catch (const oobleck::NumericalError& e) {
+    fmt::print(stderr, "oobleck: numerical failure: {}\n", e.what());
+    return 3;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "oobleck: error: {}\n", e.what());
+    return 3;
+  }
+  return 0;
+}

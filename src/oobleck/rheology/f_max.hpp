@@ -1,0 +1,19 @@
+#pragma once
+// Upper bound of the steady structure, model.md E9 (paper eq. cmax).
+#include "oobleck/rheology/params.hpp"
+
+namespace oobleck::rheology {
+
+/// phi* = phi_j + (phi_c - phi_j) Delta.
+inline double phi_star(const SteadyParams& p) { return p.phi_j + (p.phi_c - p.phi_j) * p.Delta; }
+
+/// E9: f_m(phi) = 1 for phi <= phi_c; (phi - phi_j)/(phi_c - phi_j) for phi_c < phi <= phi*;
+/// (phi* - phi_j)/(phi_c - phi_j) for phi > phi*.
+inline double f_m(const SteadyParams& p, double phi) {
+  if (phi <= p.phi_c) return 1.0;
+  const double ps = phi_star(p);
+  const double phi_eff = phi <= ps ? phi : ps;
+  return (phi_eff - p.phi_j) / (p.phi_c - p.phi_j);
+}
+
+}  // namespace oobleck::rheology

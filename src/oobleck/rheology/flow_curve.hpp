@@ -1,0 +1,49 @@
+#pragma once
+// Steady simple-shear flow curves of the Baumgarten–Kamrin model, complete with every branch:
+// the curve is swept parametrically in the structure f (model.md E11), so S-shaped and DST
+// branches are never lost by a root finder in gamma_dot or tau. Asymptotes E12–E14.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "oobleck/rheology/params.hpp"
+
+namespace oobleck::rheology {
+
+/// One steady state of homogeneous simple shear at volume fraction phi and structure f.
+struct SteadyPoint {
+  double phi = 0.0;
+  double f = 0.0;
+  double shear_rate = 0.0;             ///< gamma_dot [1/s]
+  double shear_stress = 0.0;           ///< mixture tau = eta_r eta_0 gamma_dot [Pa]
+  double granular_pressure = 0.0;      ///< p~ = eta_n eta_0 gamma_dot [Pa] (E4)
+  double granular_shear_stress = 0.0;  ///< tau_bar = (mu_c + mu_h) p~ [Pa] (E5)
+  double viscosity = 0.0;              ///< tau/gamma_dot [Pa s]
+  double eta_r = 0.0;                  ///< relative viscosity (E3)
+};
+
+/// Throws InputError unless 0 < phi < phi_j (`where` names the source of phi, e.g. "--phi").
+void validate_phi(const SteadyParams& p, double phi, const std::string& where);
+
+/// Upper end of the structure sweep: f_u = min(f_m(phi), f_jam(phi)) (model.md §2).
+double f_upper(const SteadyParams& p, double phi);
+
+/// Steady state at structure f, where `gap` = f_u - f is given separately so that states
+/// arbitrarily close to f_u are computed without cancellation. E11 for xi_dot_eps = 0; a
+/// monotone safeguarded Newton solve in ln(gamma_dot) for xi_dot_eps > 0.
+SteadyPoint steady_point(const SteadyParams& p, double phi, double f, double gap);
+
+/// The flow curve at phi: `points` states with f increasing from 1e-10 f_u to f_u (1 - 1e-10),
+/// clustered logistically at both ends so the asymptotes are resolved.
+std::vector<SteadyPoint> flow_curve(const SteadyParams& p, double phi, int points = 400);
+
+/// E12: relative viscosity of the low-viscosity (f -> 0) branch.
+double eta_r_low(const SteadyParams& p, double phi);
+/// E13: relative viscosity of the high-viscosity (f -> 1) branch; defined for phi < phi_c.
+double eta_r_high(const SteadyParams& p, double phi);
+
+/// E14: the DST shear rate [1/s] for phi_c <= phi <= phi* with finite eta_B; nullopt where DST
+/// does not apply (then `reason`, if given, says why).
+std::optional<double> shear_rate_dst(const SteadyParams& p, double phi, std::string* reason = nullptr);
+
+}  // namespace oobleck::rheology
