@@ -69,7 +69,9 @@ void flow_curve_command(CLI::App& rheology) {
     fmt::print("wrote {} ({} curves x {} points; parameters {} [{} units])\n", o->out, o->phi.size(), o->points,
                p.name, p.units);
     if (!o->png.empty()) {
-      plot("plot_flow_curves.py", {o->out, "--title", fmt::format("{} ({} units)", p.name, p.units)}, o->png);
+      std::vector<std::string> args = {o->out, "--title", fmt::format("{} ({} units)", p.name, p.units)};
+      if (p.units == "normalized") args.emplace_back("--normalized");
+      plot("plot_flow_curves.py", args, o->png);
       fmt::print("wrote {}\n", o->png);
     }
   });

@@ -55,8 +55,17 @@ std::optional<double> TomlReader::optional_number(std::string_view key) {
 
 double TomlReader::number(std::string_view key) {
   auto v = optional_number(key);
-  if (!v) fail(key, "missing (required number)");
+  if (!v) fail(key, "missing (required number)" + misspelled_hint(key));
   return *v;
+}
+
+std::string TomlReader::misspelled_hint(std::string_view key) const {
+  std::vector<std::string> unknown;
+  for (const auto& [k, v] : *table_) {
+    if (used_.count(k.str()) == 0) unknown.emplace_back(k.str());
+  }
+  const std::string near = closest_match(std::string(key), unknown);
+  return near.empty() ? std::string() : fmt::format("; found unknown key '{}' — a misspelling?", key_path(near));
 }
 
 double TomlReader::number_or(std::string_view key, double fallback) {
@@ -65,7 +74,7 @@ double TomlReader::number_or(std::string_view key, double fallback) {
 
 std::string TomlReader::string(std::string_view key) {
   const toml::node* node = lookup(key);
-  if (node == nullptr) fail(key, "missing (required string)");
+  if (node == nullptr) fail(key, "missing (required string)" + misspelled_hint(key));
   if (!node->is_string()) fail(key, "must be a string");
   return *node->value<std::string>();
 }

@@ -46,6 +46,7 @@ class TomlReader {
 
  private:
   const toml::node* lookup(std::string_view key);
+  std::string misspelled_hint(std::string_view key) const;
   const toml::table* table_;
   std::string file_;
   std::string path_;
