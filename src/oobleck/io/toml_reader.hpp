@@ -41,6 +41,9 @@ class TomlReader {
   /// Throw InputError "<file>: key '<path.key>': <message>".
   [[noreturn]] void fail(std::string_view key, std::string_view message) const;
 
+  /// The raw node of `key` (nullptr when absent); records the key as known.
+  const toml::node* raw(std::string_view key) { return lookup(key); }
+
   /// Error on any key of this table that was never read (typos, unsupported options).
   void finish() const;
 

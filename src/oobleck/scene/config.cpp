@@ -1,0 +1,364 @@
+#include "oobleck/scene/config.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "oobleck/core/error.hpp"
+#include "oobleck/io/toml_reader.hpp"
+
+namespace oobleck::scene {
+
+namespace {
+
+template <class E, std::size_t N>
+E parse_enum(io::TomlReader& t, std::string_view key, E fallback,
+             const std::array<std::pair<const char*, E>, N>& names) {
+  if (!t.has(key)) {
+    (void)t.string_or(key, "");
+    return fallback;
+  }
+  const std::string v = t.string(key);
+  std::vector<std::string> options;
+  for (const auto& [n, e] : names) {
+    if (v == n) return e;
+    options.emplace_back(n);
+  }
+  const std::string hint = closest_match(v, options);
+  t.fail(key, fmt::format("= \"{}\": must be one of {}{}", v, fmt::join(options, ", "),
+                          hint.empty() ? "" : fmt::format(" (did you mean \"{}\"?)", hint)));
+}
+
+/// Read an array of `dim` numbers (or fewer allowed = `min_len`) into a 3-array.
+std::array<double, 3> read_vec(io::TomlReader& t, std::string_view key, int dim, std::array<double, 3> fallback,
+                               bool required, int min_len = -1) {
+  if (min_len < 0) min_len = dim;
+  if (!t.has(key)) {
+    if (required) t.fail(key, fmt::format("missing (required array of {} numbers)", dim));
+    (void)t.optional_number(key);  // records the key as known
+    return fallback;
+  }
+  const toml::array* arr = t.raw(key)->as_array();
+  if (arr == nullptr) t.fail(key, fmt::format("must be an array of {} numbers [m, ...]", dim));
+  if (static_cast<int>(arr->size()) < min_len || static_cast<int>(arr->size()) > 3 ||
+      (min_len == dim && static_cast<int>(arr->size()) != dim && dim == 3)) {
+    t.fail(key, fmt::format("has {} entries; expected {}", arr->size(), dim));
+  }
+  std::array<double, 3> out = fallback;
+  for (std::size_t i = 0; i < arr->size(); ++i) {
+    const auto v = (*arr)[i].value<double>();
+    if (!v || !std::isfinite(*v)) t.fail(key, fmt::format("entry {} is not a finite number", i));
+    out[i] = *v;
+  }
+  return out;
+}
+
+void set_material_overrides(rheology::Preset& p, io::TomlReader& mat) {
+  if (auto s = mat.optional_table("steady")) {
+    std::map<std::string, double*> keys = {
+        {"phi_c", &p.steady.phi_c},       {"phi_j", &p.steady.phi_j}, {"a_0", &p.steady.a_0},
+        {"a_inf", &p.steady.a_inf},       {"tau_star", &p.steady.tau_star}, {"eta_0", &p.steady.eta_0},
+        {"mu_c", &p.steady.mu_c},         {"Delta", &p.steady.Delta},
+        {"xi_dot_eps", &p.steady.xi_dot_eps}};
+    for (auto& [k, ptr] : keys) *ptr = s->number_or(k, *ptr);
+    s->finish();
+  }
+  if (auto g = mat.optional_table("granular")) {
+    std::map<std::string, double*> keys = {{"d", &p.granular.d},     {"rho_s", &p.granular.rho_s},
+                                           {"mu_2", &p.granular.mu_2}, {"b", &p.granular.b},
+                                           {"K_3", &p.granular.K_3}, {"K_4", &p.granular.K_4},
+                                           {"G", &p.granular.G},     {"K", &p.granular.K},
+                                           {"K_0", &p.granular.K_0}};
+    for (auto& [k, ptr] : keys) *ptr = g->number_or(k, *ptr);
+    g->finish();
+  }
+}
+
+/// Apply one --set override to the parsed document.
+void apply_override(toml::table& root, const std::string& file, const std::string& spec,
+                    const std::map<std::string, std::string>& aliases) {
+  const auto eq = spec.find('=');
+  if (eq == std::string::npos || eq == 0) {
+    throw InputError(fmt::format("--set '{}': expected key=value", spec));
+  }
+  std::string key = spec.substr(0, eq);
+  const std::string value = spec.substr(eq + 1);
+  if (auto it = aliases.find(key); it != aliases.end()) key = it->second;
+  // Parse the value as a TOML value; bare words become strings.
+  toml::table holder;
+  try {
+    holder = toml::parse("v = " + value);
+  } catch (const toml::parse_error&) {
+    holder.insert_or_assign("v", value);
+  }
+  std::vector<std::string> parts;
+  std::stringstream ss(key);
+  for (std::string part; std::getline(ss, part, '.');) parts.push_back(part);
+  toml::node* node = &root;
+  for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+    const std::string& part = parts[i];
+    if (auto* tbl = node->as_table()) {
+      node = tbl->get(part);
+    } else if (auto* arr = node->as_array()) {
+      char* end = nullptr;
+      const long idx = std::strtol(part.c_str(), &end, 10);
+      node = (end != part.c_str() && *end == '\0' && idx >= 0 && idx < static_cast<long>(arr->size()))
+                 ? arr->get(static_cast<std::size_t>(idx))
+                 : nullptr;
+    } else {
+      node = nullptr;
+    }
+    if (node == nullptr) {
+      std::vector<std::string> alias_names;
+      for (const auto& [a, target] : aliases) alias_names.push_back(a);
+      throw InputError(fmt::format("--set {}: {} has no section '{}'{}", spec, file, part,
+                                   alias_names.empty() ? std::string()
+                                                       : fmt::format(" (short names: {})", fmt::join(alias_names, ", "))));
+    }
+  }
+  auto* parent = node->as_table();
+  if (parent == nullptr) throw InputError(fmt::format("--set {}: '{}' is not a table in {}", spec, key, file));
+  parent->insert_or_assign(parts.back(), *holder.get("v"));
+}
+
+constexpr std::array<std::pair<const char*, Geometry>, 3> kGeometries{
+    {{"plane_strain", Geometry::PlaneStrain}, {"axisymmetric", Geometry::Axisymmetric}, {"3d", Geometry::ThreeD}}};
+constexpr std::array<std::pair<const char*, ShapeKind>, 4> kShapes{{{"linear", ShapeKind::Linear},
+                                                                    {"quadratic", ShapeKind::Quadratic},
+                                                                    {"cubic", ShapeKind::Cubic},
+                                                                    {"ugimp", ShapeKind::UGimp}}};
+constexpr std::array<std::pair<const char*, BoundaryType>, 6> kBoundaries{{{"no_slip", BoundaryType::NoSlip},
+                                                                          {"slip", BoundaryType::Slip},
+                                                                          {"friction", BoundaryType::Friction},
+                                                                          {"velocity", BoundaryType::Velocity},
+                                                                          {"periodic", BoundaryType::Periodic},
+                                                                          {"open", BoundaryType::Open}}};
+constexpr std::array<std::pair<const char*, Phase>, 4> kPhases{
+    {{"mixture", Phase::Mixture}, {"fluid", Phase::Fluid}, {"grains", Phase::Grains}, {"elastic", Phase::Elastic}}};
+
+template <class E, std::size_t N>
+const char* name_of(E e, const std::array<std::pair<const char*, E>, N>& names) {
+  for (const auto& [n, v] : names) {
+    if (v == e) return n;
+  }
+  return "?";
+}
+
+}  // namespace
+
+const char* to_string(Geometry g) { return name_of(g, kGeometries); }
+const char* to_string(ShapeKind s) { return name_of(s, kShapes); }
+const char* to_string(BoundaryType b) { return name_of(b, kBoundaries); }
+const char* to_string(Phase p) { return name_of(p, kPhases); }
+
+const std::array<const char*, 6>& face_names() {
+  static const std::array<const char*, 6> n = {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"};
+  return n;
+}
+
+SceneConfig load_scene(const std::string& path, const std::vector<std::string>& overrides) {
+  toml::table root = io::parse_toml_file(path);
+  SceneConfig c;
+  c.file = path;
+
+  // Aliases first: they give --set its short names.
+  if (auto* al = root.get_as<toml::table>("aliases")) {
+    for (const auto& [k, v] : *al) {
+      if (!v.is_string()) throw InputError(fmt::format("{}: key 'aliases.{}': must be a string key path", path, k.str()));
+      c.aliases[std::string(k.str())] = *v.value<std::string>();
+    }
+  }
+  for (const auto& o : overrides) apply_override(root, path, o, c.aliases);
+
+  io::TomlReader top(root, path);
+  (void)top.optional_table("aliases");
+
+  io::TomlReader sc = top.table("scene");
+  c.name = sc.string("name");
+  c.description = sc.string_or("description", "");
+  sc.finish();
+
+  // [grid]
+  io::TomlReader g = top.table("grid");
+  c.grid.geometry = parse_enum(g, "geometry", Geometry::PlaneStrain, kGeometries);
+  c.grid.dim = c.grid.geometry == Geometry::ThreeD ? 3 : 2;
+  const int dim = c.grid.dim;
+  c.grid.origin_m = read_vec(g, "origin", dim, {0, 0, 0}, false);
+  c.grid.size_m = read_vec(g, "size", dim, {0, 0, 0}, true);
+  c.grid.cell_size_m = g.number("cell_size");
+  g.require(c.grid.cell_size_m > 0.0 && std::isfinite(c.grid.cell_size_m), "cell_size", c.grid.cell_size_m,
+            "must be positive [m]");
+  for (int a = 0; a < dim; ++a) {
+    const double n = c.grid.size_m[a] / c.grid.cell_size_m;
+    g.require(c.grid.size_m[a] > 0.0, "size", c.grid.size_m[a], fmt::format("entry {} must be positive [m]", a));
+    g.require(std::fabs(n - std::round(n)) < 1e-6 * n, "size", c.grid.size_m[a],
+              fmt::format("entry {} must be a whole number of cells of cell_size = {} m", a, c.grid.cell_size_m));
+    c.grid.cells[a] = static_cast<int>(std::lround(n));
+  }
+  if (c.grid.geometry == Geometry::Axisymmetric) {
+    g.require(c.grid.origin_m[0] >= 0.0, "origin", c.grid.origin_m[0], "axisymmetric: r_0 = origin[0] must be >= 0");
+  }
+  c.grid.shape = parse_enum(g, "shape_function", ShapeKind::Quadratic, kShapes);
+  g.finish();
+
+  // [material]: preset or params file, plus overrides
+  io::TomlReader m = top.table("material");
+  const std::string preset = m.string_or("preset", "");
+  const std::string params = m.string_or("params", "");
+  if (preset.empty() == params.empty()) m.fail("preset", "give exactly one of material.preset or material.params");
+  if (!preset.empty()) {
+    c.material = rheology::load_preset(preset);
+  } else {
+    const auto rel = std::filesystem::path(path).parent_path() / params;
+    c.material = rheology::load_params_file(std::filesystem::path(params).is_absolute() ? params : rel.string());
+  }
+  set_material_overrides(c.material, m);
+  m.finish();
+  rheology::validate(c.material, path + " [material]");
+
+  // [fluid]
+  if (auto f = top.optional_table("fluid")) {
+    c.fluid.rho_f0_kg_m3 = f->number_or("rho_f", c.fluid.rho_f0_kg_m3);
+    c.fluid.kappa_Pa = f->number_or("kappa", c.fluid.kappa_Pa);
+    c.fluid.eta_0_Pa_s = f->number_or("eta_0", c.material.steady.eta_0);
+    f->require(c.fluid.rho_f0_kg_m3 > 0, "rho_f", c.fluid.rho_f0_kg_m3, "must be positive [kg/m^3]");
+    f->require(c.fluid.kappa_Pa > 0, "kappa", c.fluid.kappa_Pa, "must be positive [Pa]");
+    f->require(c.fluid.eta_0_Pa_s > 0, "eta_0", c.fluid.eta_0_Pa_s, "must be positive [Pa s]");
+    f->finish();
+  } else {
+    c.fluid.eta_0_Pa_s = c.material.steady.eta_0;
+  }
+  c.material.steady.eta_0 = c.fluid.eta_0_Pa_s;  // one viscosity for both laws
+
+  // [coupling]
+  if (auto cp = top.optional_table("coupling")) {
+    constexpr std::array<std::pair<const char*, DragLaw>, 2> kDrag{
+        {{"beetstra", DragLaw::Beetstra}, {"carman_kozeny", DragLaw::CarmanKozeny}}};
+    c.coupling.drag = parse_enum(*cp, "drag", DragLaw::Beetstra, kDrag);
+    c.coupling.porosity_min = cp->number_or("porosity_min", c.coupling.porosity_min);
+    cp->require(c.coupling.porosity_min > 0 && c.coupling.porosity_min < 1, "porosity_min", c.coupling.porosity_min,
+                "must lie in (0, 1)");
+    cp->finish();
+  }
+
+  // [transfer]
+  if (auto tr = top.optional_table("transfer")) {
+    constexpr std::array<std::pair<const char*, TransferScheme>, 2> kSchemes{
+        {{"apic", TransferScheme::Apic}, {"flip", TransferScheme::Flip}}};
+    c.transfer.scheme = parse_enum(*tr, "scheme", TransferScheme::Apic, kSchemes);
+    c.transfer.flip_fraction = tr->number_or("flip_fraction", c.transfer.flip_fraction);
+    tr->require(c.transfer.flip_fraction >= 0 && c.transfer.flip_fraction <= 1, "flip_fraction",
+                c.transfer.flip_fraction, "must lie in [0, 1]");
+    tr->finish();
+  }
+
+  // [[region]]
+  auto regions = top.table_array("region");
+  if (regions.empty()) top.fail("region", "missing: at least one [[region]] of material points is required");
+  for (std::size_t i = 0; i < regions.size(); ++i) {
+    io::TomlReader& r = regions[i];
+    RegionConfig reg;
+    reg.name = r.string_or("name", fmt::format("region{}", i));
+    reg.phase = parse_enum(r, "phase", Phase::Mixture, kPhases);
+    reg.min_m = read_vec(r, "min", dim, {0, 0, 0}, true);
+    reg.max_m = read_vec(r, "max", dim, {0, 0, 0}, true);
+    for (int a = 0; a < dim; ++a) {
+      r.require(reg.max_m[a] > reg.min_m[a], "max", reg.max_m[a], fmt::format("entry {} must exceed min[{}]", a, a));
+      r.require(reg.min_m[a] >= c.grid.origin_m[a] - 1e-12 &&
+                    reg.max_m[a] <= c.grid.origin_m[a] + c.grid.size_m[a] + 1e-12,
+                "max", reg.max_m[a], fmt::format("the box must lie inside the grid along axis {}", a));
+    }
+    const bool has_grains = reg.phase == Phase::Mixture || reg.phase == Phase::Grains;
+    reg.phi = has_grains ? r.number("phi") : r.number_or("phi", 0.0);
+    if (has_grains) {
+      r.require(reg.phi > 0 && reg.phi < 1, "phi", reg.phi, "must lie in (0, 1)");
+    }
+    reg.points_per_cell = static_cast<int>(r.number_or("points_per_cell", 2));
+    r.require(reg.points_per_cell >= 1 && reg.points_per_cell <= 8, "points_per_cell", reg.points_per_cell,
+              "must be an integer in [1, 8] (per axis)");
+    const int ncomp = c.grid.geometry == Geometry::PlaneStrain ? 2 : 3;
+    reg.velocity_m_s = read_vec(r, "velocity", ncomp, {0, 0, 0}, false, dim);
+    constexpr std::array<std::pair<const char*, InitialState>, 2> kInit{
+        {{"at_rest", InitialState::AtRest}, {"hydrostatic", InitialState::Hydrostatic}}};
+    reg.initial_state = parse_enum(r, "initial_state", InitialState::AtRest, kInit);
+    if (reg.phase == Phase::Elastic) {
+      reg.elastic.density_kg_m3 = r.number("density");
+      reg.elastic.youngs_modulus_Pa = r.number("youngs_modulus");
+      reg.elastic.poisson_ratio = r.number_or("poisson_ratio", 0.3);
+      r.require(reg.elastic.density_kg_m3 > 0, "density", reg.elastic.density_kg_m3, "must be positive [kg/m^3]");
+      r.require(reg.elastic.youngs_modulus_Pa > 0, "youngs_modulus", reg.elastic.youngs_modulus_Pa,
+                "must be positive [Pa]");
+      r.require(reg.elastic.poisson_ratio > -1 && reg.elastic.poisson_ratio < 0.5, "poisson_ratio",
+                reg.elastic.poisson_ratio, "must lie in (-1, 0.5)");
+    }
+    r.finish();
+    c.regions.push_back(reg);
+  }
+
+  // [boundary]
+  if (auto b = top.optional_table("boundary")) {
+    for (int face = 0; face < 2 * dim; ++face) {
+      const char* fname = face_names()[face];
+      auto fb = b->optional_table(fname);
+      if (!fb) continue;
+      BoundaryConfig& bc = c.boundary[face];
+      bc.type = parse_enum(*fb, "type", BoundaryType::NoSlip, kBoundaries);
+      if (bc.type == BoundaryType::Friction) {
+        bc.friction = fb->number("friction");
+        fb->require(bc.friction >= 0, "friction", bc.friction, "must be >= 0");
+      }
+      if (bc.type == BoundaryType::Velocity) {
+        const int ncomp = c.grid.geometry == Geometry::PlaneStrain ? 2 : 3;
+        bc.velocity_m_s = read_vec(*fb, "velocity", ncomp, {0, 0, 0}, true, dim);
+      }
+      fb->finish();
+    }
+    b->finish();
+  }
+  for (int a = 0; a < dim; ++a) {
+    const bool lo = c.boundary[2 * a].type == BoundaryType::Periodic;
+    const bool hi = c.boundary[2 * a + 1].type == BoundaryType::Periodic;
+    if (lo != hi) {
+      throw InputError(fmt::format("{}: key 'boundary.{}': periodic faces come in pairs ({} and {})", path,
+                                   face_names()[2 * a], face_names()[2 * a], face_names()[2 * a + 1]));
+    }
+  }
+  if (c.grid.geometry == Geometry::Axisymmetric && c.boundary[0].type == BoundaryType::Periodic) {
+    throw InputError(fmt::format("{}: key 'boundary.x_min': the radial axis cannot be periodic", path));
+  }
+
+  if (auto ph = top.optional_table("physics")) {
+    c.gravity_m_s2 = read_vec(*ph, "gravity", dim, {0, 0, 0}, false);
+    ph->finish();
+  }
+
+  // [time]
+  io::TomlReader t = top.table("time");
+  c.time.duration_s = t.number("duration");
+  t.require(c.time.duration_s > 0 && std::isfinite(c.time.duration_s), "duration", c.time.duration_s,
+            "must be positive [s]");
+  c.time.dt_s = t.optional_number("dt");
+  if (c.time.dt_s) t.require(*c.time.dt_s > 0, "dt", *c.time.dt_s, "must be positive [s]");
+  c.time.cfl = t.number_or("cfl", c.time.cfl);
+  t.require(c.time.cfl > 0 && c.time.cfl <= 1, "cfl", c.time.cfl, "must lie in (0, 1]");
+  t.finish();
+
+  // [output]
+  if (auto o = top.optional_table("output")) {
+    c.output.frame_interval_s = o->number_or("frame_interval", 0.0);
+    c.output.series_interval_s = o->number_or("series_interval", 0.0);
+    const double ce = o->number_or("checkpoint_every", 0.0);
+    o->require(c.output.frame_interval_s >= 0, "frame_interval", c.output.frame_interval_s, "must be >= 0 [s]");
+    o->require(c.output.series_interval_s >= 0, "series_interval", c.output.series_interval_s, "must be >= 0 [s]");
+    o->require(ce >= 0 && ce == std::floor(ce), "checkpoint_every", ce, "must be a whole number of steps >= 0");
+    c.output.checkpoint_every = static_cast<long>(ce);
+    o->finish();
+  }
+  top.finish();
+  return c;
+}
+
+}  // namespace oobleck::scene

@@ -1,0 +1,116 @@
+#pragma once
+// A scene file (TOML) as typed, validated data: geometry, suspension material, fluid, coupling,
+// transfer scheme, regions of material points, boundaries, gravity, time stepping and output.
+// Every key is named with its unit in docs/scenes.md; unknown keys are errors with a suggestion.
+// This layer knows nothing of the solver; scene/build.* turns a SceneConfig into bodies.
+#include <array>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "oobleck/rheology/params.hpp"
+
+namespace oobleck::scene {
+
+enum class Geometry { PlaneStrain, Axisymmetric, ThreeD };
+enum class ShapeKind { Linear, Quadratic, Cubic, UGimp };
+enum class TransferScheme { Apic, Flip };
+enum class DragLaw { Beetstra, CarmanKozeny };
+enum class Phase { Mixture, Fluid, Grains, Elastic };
+enum class InitialState { AtRest, Hydrostatic };
+enum class BoundaryType { NoSlip, Slip, Friction, Velocity, Periodic, Open };
+
+const char* to_string(Geometry g);
+const char* to_string(ShapeKind s);
+const char* to_string(BoundaryType b);
+const char* to_string(Phase p);
+
+struct GridConfig {
+  Geometry geometry = Geometry::PlaneStrain;
+  int dim = 2;                              ///< 2 (plane strain, axisymmetric) or 3
+  std::array<double, 3> origin_m{0, 0, 0};  ///< [m] lower corner (axisymmetric: (r_0, z_0))
+  std::array<double, 3> size_m{0, 0, 0};    ///< [m] domain extent per axis
+  double cell_size_m = 0.0;                 ///< [m] h
+  std::array<int, 3> cells{1, 1, 1};        ///< derived: size/h (must be an integer)
+  ShapeKind shape = ShapeKind::Quadratic;
+};
+
+struct FluidConfig {
+  double rho_f0_kg_m3 = 1000.0;  ///< [kg/m^3] rest true density of the fluid
+  double kappa_Pa = 1e6;         ///< [Pa] fluid bulk modulus (E26; the paper does not give it)
+  double eta_0_Pa_s = 0.0;       ///< [Pa s] fluid viscosity (default: the material's eta_0)
+};
+
+struct CouplingConfig {
+  DragLaw drag = DragLaw::Beetstra;
+  double porosity_min = 0.2;  ///< [-] lower clamp of nodal porosity n (model.md §5)
+};
+
+struct TransferConfig {
+  TransferScheme scheme = TransferScheme::Apic;
+  double flip_fraction = 0.99;  ///< FLIP/PIC blend for scheme = "flip" (1 = pure FLIP)
+};
+
+struct ElasticConfig {
+  double density_kg_m3 = 0.0;
+  double youngs_modulus_Pa = 0.0;
+  double poisson_ratio = 0.0;
+};
+
+/// A region of the domain filled with material points.
+struct RegionConfig {
+  std::string name;
+  Phase phase = Phase::Mixture;
+  std::array<double, 3> min_m{0, 0, 0}, max_m{0, 0, 0};  ///< [m] box corners
+  double phi = 0.0;                                       ///< [-] granular volume fraction (mixture/grains)
+  int points_per_cell = 2;                                ///< per axis and per phase
+  std::array<double, 3> velocity_m_s{0, 0, 0};            ///< [m/s] initial velocity (3 comps; v_theta third in axisymmetric)
+  InitialState initial_state = InitialState::AtRest;
+  ElasticConfig elastic;                                  ///< for phase = "elastic"
+};
+
+struct BoundaryConfig {
+  BoundaryType type = BoundaryType::NoSlip;
+  double friction = 0.0;                        ///< Coulomb coefficient (type = friction)
+  std::array<double, 3> velocity_m_s{0, 0, 0};  ///< prescribed velocity (type = velocity)
+};
+
+struct TimeConfig {
+  double duration_s = 0.0;           ///< [s] simulated time
+  std::optional<double> dt_s;        ///< [s] user time step (refused above the stable one)
+  double cfl = 0.4;                  ///< fraction of the stable time step used by default
+};
+
+struct OutputConfig {
+  double frame_interval_s = 0.0;   ///< [s] HDF5 frame interval (0: first and last only)
+  double series_interval_s = 0.0;  ///< [s] CSV series interval (0: every 100 steps)
+  long checkpoint_every = 0;       ///< steps between checkpoints (0: none)
+};
+
+struct SceneConfig {
+  std::string file;
+  std::string name;
+  std::string description;
+  GridConfig grid;
+  rheology::Preset material;             ///< suspension parameters (preset + overrides)
+  FluidConfig fluid;
+  CouplingConfig coupling;
+  TransferConfig transfer;
+  std::vector<RegionConfig> regions;
+  std::array<BoundaryConfig, 6> boundary;  ///< x_min, x_max, y_min, y_max, z_min, z_max
+  std::array<double, 3> gravity_m_s2{0, 0, 0};
+  TimeConfig time;
+  OutputConfig output;
+  std::map<std::string, std::string> aliases;  ///< short --set names -> full key paths
+};
+
+/// Face names in the order of SceneConfig::boundary.
+const std::array<const char*, 6>& face_names();
+
+/// Parse and validate a scene file. `overrides` are "key.path=value" strings (--set); a key may
+/// be a full dotted path ("region.0.phi" or "grid.cell_size") or an alias declared in the scene's
+/// [aliases] table. Values are parsed as TOML values (numbers, strings in quotes or bare words).
+SceneConfig load_scene(const std::string& path, const std::vector<std::string>& overrides = {});
+
+}  // namespace oobleck::scene

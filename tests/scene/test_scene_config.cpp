@@ -1,0 +1,94 @@
+// Scene files: typed, validated configuration; --set overrides with short aliases; errors name
+// the file, the key and the rule.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "oobleck/core/error.hpp"
+#include "oobleck/scene/config.hpp"
+
+using namespace oobleck;
+
+namespace {
+const std::string kSettling = std::string(OOBLECK_SOURCE_DIR) + "/scenes/verification/settling.toml";
+
+std::string read_all(const std::string& p) {
+  std::ifstream in(p);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+/// Error message of loading a copy of settling.toml with `from` replaced by `to`.
+std::string error_with(const std::string& from, const std::string& to, std::vector<std::string> sets = {}) {
+  std::string s = read_all(kSettling);
+  if (!from.empty()) {
+    const auto pos = s.find(from);
+    EXPECT_NE(pos, std::string::npos) << from;
+    s.replace(pos, from.size(), to);
+  }
+  const auto path = (std::filesystem::temp_directory_path() / "oobleck_scene_test.toml").string();
+  std::ofstream(path) << s;
+  try {
+    scene::load_scene(path, sets);
+  } catch (const InputError& e) {
+    std::remove(path.c_str());
+    return e.what();
+  }
+  std::remove(path.c_str());
+  return "";
+}
+}  // namespace
+
+TEST(SceneConfig, SettlingSceneLoads) {
+  const auto c = scene::load_scene(kSettling);
+  EXPECT_EQ(c.name, "settling");
+  EXPECT_EQ(c.grid.cells[0], 4);
+  EXPECT_EQ(c.grid.cells[1], 20);
+  EXPECT_EQ(c.material.name, "hermes2016");
+  EXPECT_DOUBLE_EQ(c.material.granular.d, 1e-4);       // override
+  EXPECT_DOUBLE_EQ(c.material.steady.phi_j, 0.535);    // from the preset
+  EXPECT_DOUBLE_EQ(c.material.steady.eta_0, 1e-3);     // fluid viscosity is the one viscosity
+  EXPECT_EQ(c.boundary[0].type, scene::BoundaryType::Periodic);
+  ASSERT_EQ(c.regions.size(), 1u);
+  EXPECT_DOUBLE_EQ(c.regions[0].phi, 0.1);
+  EXPECT_DOUBLE_EQ(c.gravity_m_s2[1], -9.81);
+}
+
+TEST(SceneConfig, SetOverridesByAliasAndFullPath) {
+  const auto c = scene::load_scene(kSettling, {"phi=0.2", "fluid.kappa=3e5", "grid.shape_function=cubic"});
+  EXPECT_DOUBLE_EQ(c.regions[0].phi, 0.2);
+  EXPECT_DOUBLE_EQ(c.fluid.kappa_Pa, 3e5);
+  EXPECT_EQ(c.grid.shape, scene::ShapeKind::Cubic);
+}
+
+TEST(SceneConfig, ErrorsNameFileKeyAndRule) {
+  std::string e = error_with("kappa = 2.0e5", "kapa = 2.0e5");
+  EXPECT_NE(e.find("fluid.kapa"), std::string::npos) << e;
+  EXPECT_NE(e.find("did you mean 'fluid.kappa'"), std::string::npos) << e;
+  EXPECT_NE(e.find("oobleck_scene_test.toml"), std::string::npos) << e;
+
+  e = error_with("G = 1.0e4", "G = -1.0e4");
+  EXPECT_NE(e.find("granular.G"), std::string::npos) << e;
+  EXPECT_NE(e.find("positive"), std::string::npos) << e;
+
+  e = error_with("cell_size = 0.001", "cell_size = \"fine\"");
+  EXPECT_NE(e.find("grid.cell_size"), std::string::npos) << e;
+  EXPECT_NE(e.find("must be a number"), std::string::npos) << e;
+
+  e = error_with("cell_size = 0.001", "cell_size = 0.0015");
+  EXPECT_NE(e.find("whole number of cells"), std::string::npos) << e;
+
+  e = error_with("shape_function = \"quadratic\"", "shape_function = \"quadratc\"");
+  EXPECT_NE(e.find("did you mean \"quadratic\""), std::string::npos) << e;
+
+  e = error_with("x_max = { type = \"periodic\" }", "x_max = { type = \"slip\" }");
+  EXPECT_NE(e.find("periodic faces come in pairs"), std::string::npos) << e;
+
+  e = error_with("", "", {"nosuch.key=1"});
+  EXPECT_NE(e.find("no section 'nosuch'"), std::string::npos) << e;
+  EXPECT_NE(e.find("short names"), std::string::npos) << e;
+
+  e = error_with("", "", {"phi=1.5"});
+  EXPECT_NE(e.find("region[0].phi"), std::string::npos) << e;
+}
