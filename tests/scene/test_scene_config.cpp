@@ -92,3 +92,14 @@ TEST(SceneConfig, ErrorsNameFileKeyAndRule) {
   e = error_with("", "", {"phi=1.5"});
   EXPECT_NE(e.find("region[0].phi"), std::string::npos) << e;
 }
+
+TEST(SceneConfig, BenchmarkScenesLoadWithTheAuthorsPointCounts) {
+  const auto a = scene::load_scene(std::string(OOBLECK_SOURCE_DIR) + "/bench/scenes/intruder_authors_setup.toml");
+  EXPECT_EQ(a.grid.geometry, scene::Geometry::Axisymmetric);
+  EXPECT_EQ(a.grid.cells[0], 50);
+  EXPECT_EQ(a.grid.cells[1], 35);
+  const auto b = scene::load_scene(std::string(OOBLECK_SOURCE_DIR) + "/bench/scenes/wheel_authors_setup.toml");
+  EXPECT_EQ(b.grid.cells[0], 150);
+  EXPECT_EQ(b.grid.cells[1], 75);
+  EXPECT_NEAR(b.grid.cell_size_m, 2.0 / 150.0, 1e-15);
+}

@@ -130,7 +130,8 @@ constexpr std::array<std::pair<const char*, ShapeKind>, 4> kShapes{{{"linear", S
                                                                     {"quadratic", ShapeKind::Quadratic},
                                                                     {"cubic", ShapeKind::Cubic},
                                                                     {"ugimp", ShapeKind::UGimp}}};
-constexpr std::array<std::pair<const char*, BoundaryType>, 6> kBoundaries{{{"no_slip", BoundaryType::NoSlip},
+constexpr std::array<std::pair<const char*, BoundaryType>, 7> kBoundaries{{{"no_slip", BoundaryType::NoSlip},
+                                                                          {"axis", BoundaryType::Axis},
                                                                           {"slip", BoundaryType::Slip},
                                                                           {"friction", BoundaryType::Friction},
                                                                           {"velocity", BoundaryType::Velocity},
@@ -188,14 +189,24 @@ SceneConfig load_scene(const std::string& path, const std::vector<std::string>& 
   const int dim = c.grid.dim;
   c.grid.origin_m = read_vec(g, "origin", dim, {0, 0, 0}, false);
   c.grid.size_m = read_vec(g, "size", dim, {0, 0, 0}, true);
-  c.grid.cell_size_m = g.number("cell_size");
+  // Either cell_size [m] (size must be a whole number of cells) or cells along the first axis.
+  if (g.has("cells")) {
+    const auto n = read_vec(g, "cells", dim, {1, 1, 1}, true);
+    if (g.has("cell_size")) g.fail("cells", "give either grid.cells or grid.cell_size, not both");
+    (void)g.optional_number("cell_size");
+    g.require(n[0] >= 1 && n[0] == std::floor(n[0]), "cells", n[0], "entries must be whole numbers >= 1");
+    c.grid.cell_size_m = c.grid.size_m[0] / n[0];
+  } else {
+    c.grid.cell_size_m = g.number("cell_size");
+  }
   g.require(c.grid.cell_size_m > 0.0 && std::isfinite(c.grid.cell_size_m), "cell_size", c.grid.cell_size_m,
             "must be positive [m]");
   for (int a = 0; a < dim; ++a) {
     const double n = c.grid.size_m[a] / c.grid.cell_size_m;
     g.require(c.grid.size_m[a] > 0.0, "size", c.grid.size_m[a], fmt::format("entry {} must be positive [m]", a));
     g.require(std::fabs(n - std::round(n)) < 1e-6 * n, "size", c.grid.size_m[a],
-              fmt::format("entry {} must be a whole number of cells of cell_size = {} m", a, c.grid.cell_size_m));
+              fmt::format("entry {} must be a whole number of cells of size {} m (square cells)", a,
+                          c.grid.cell_size_m));
     c.grid.cells[a] = static_cast<int>(std::lround(n));
   }
   if (c.grid.geometry == Geometry::Axisymmetric) {
@@ -298,7 +309,9 @@ SceneConfig load_scene(const std::string& path, const std::vector<std::string>& 
     c.regions.push_back(reg);
   }
 
-  // [boundary]
+  // [boundary]; on the axis of an axisymmetric grid (r_0 = 0) only v_r and v_theta vanish.
+  const bool on_axis = c.grid.geometry == Geometry::Axisymmetric && c.grid.origin_m[0] == 0.0;
+  if (on_axis) c.boundary[0].type = BoundaryType::Axis;
   if (auto b = top.optional_table("boundary")) {
     for (int face = 0; face < 2 * dim; ++face) {
       const char* fname = face_names()[face];
@@ -313,6 +326,11 @@ SceneConfig load_scene(const std::string& path, const std::vector<std::string>& 
       if (bc.type == BoundaryType::Velocity) {
         const int ncomp = c.grid.geometry == Geometry::PlaneStrain ? 2 : 3;
         bc.velocity_m_s = read_vec(*fb, "velocity", ncomp, {0, 0, 0}, true, dim);
+      }
+      const bool axis_face = on_axis && face == 0;
+      if (axis_face != (bc.type == BoundaryType::Axis)) {
+        fb->fail("type", axis_face ? "the face r = 0 of an axisymmetric grid is the axis: type must be \"axis\""
+                                   : "type \"axis\" is only valid for x_min of an axisymmetric grid with origin r = 0");
       }
       fb->finish();
     }

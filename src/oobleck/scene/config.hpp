@@ -19,7 +19,7 @@ enum class TransferScheme { Apic, Flip };
 enum class DragLaw { Beetstra, CarmanKozeny };
 enum class Phase { Mixture, Fluid, Grains, Elastic };
 enum class InitialState { AtRest, Hydrostatic };
-enum class BoundaryType { NoSlip, Slip, Friction, Velocity, Periodic, Open };
+enum class BoundaryType { NoSlip, Slip, Friction, Velocity, Periodic, Open, Axis };
 
 const char* to_string(Geometry g);
 const char* to_string(ShapeKind s);
