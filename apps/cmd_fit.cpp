@@ -244,10 +244,17 @@ void add_fit_command(CLI::App& rheology) {
 
     std::string warning;
     if (r.rms > 0.1) {
-      warning = fmt::format("warning: rms log residual {:.3g} > 0.1 (more than 10 % scatter): the {} asymptote does "
-                            "not describe these data well; check the units (viscosity in Pa s, eta_0 = {} Pa s of "
-                            "the base set) and the choice of points",
-                            r.rms, rheology::to_string(kind), preset.steady.eta_0);
+      const std::string hint =
+          kind == rheology::FitKind::dst
+              ? fmt::format("check the units (shear_rate_dst in 1/s), the base set (phi_c, phi_j, tau_star, eta_0 = "
+                            "{} Pa s) and the number of eta_B terms (--terms)",
+                            preset.steady.eta_0)
+              : fmt::format("check the units (viscosity in Pa s, eta_0 = {} Pa s of the base set) and that the "
+                            "points are {} viscosities",
+                            preset.steady.eta_0, kind == rheology::FitKind::low ? "minimum" : "plateau (maximum)");
+      warning = fmt::format("warning: rms log residual {:.3g} > 0.1 (more than 10 % scatter): the fitted {} "
+                            "asymptote does not describe these data well; {}",
+                            r.rms, rheology::to_string(kind), hint);
     }
     if (o->json) {
       if (!warning.empty()) fmt::print(stderr, "{}\n", warning);
@@ -269,8 +276,8 @@ void add_fit_command(CLI::App& rheology) {
     }
     fmt::print("base parameter set: {} [{} units]; mu_c = {} (fixed)\n", base_desc, preset.units,
                preset.steady.mu_c);
-    fmt::print("fit --kind {} to {}: n = {} points, p = {} parameters, converged in {} iterations\n", o->kind, o->data,
-               r.n, r.p, r.iterations);
+    fmt::print("fit --kind {} to {}: n = {} points, p = {} parameters; Ceres converged ({} iterations)\n", o->kind,
+               o->data, r.n, r.p, r.iterations);
     std::size_t width = 0;
     for (const auto& p : r.parameters) width = std::max(width, p.name.size());
     for (const auto& p : r.parameters) {
@@ -280,7 +287,8 @@ void add_fit_command(CLI::App& rheology) {
     }
     if (!r.covariance_ok) {
       fmt::print("  standard errors n/a: the parameters are not all identifiable from these data (rank-deficient "
-                 "Jacobian)\n");
+                 "Jacobian){}\n",
+                 kind == rheology::FitKind::dst ? "; fit fewer eta_B terms (--terms)" : "");
     }
     fmt::print("rms log residual = {:.4g} (n = {})\n", r.rms, r.n);
     if (!warning.empty()) fmt::print("{}\n", warning);

@@ -176,6 +176,19 @@ TEST(Fit, DstDefaultsToOneTermWithoutEtaB) {
   EXPECT_EQ(fit_parameter_count(FitKind::dst, base, two), 4);
 }
 
+TEST(Fit, UnidentifiableTermsGiveNaNStdErrors) {
+  // Two eta_B terms fitted to single-power-law data: the terms coincide (or one vanishes), the
+  // Jacobian is rank-deficient, and the fit says so instead of printing meaningless errors.
+  const SteadyParams truth = load_preset("dhaene1993").steady;
+  const auto d = synthesize(FitKind::dst, truth, truth.phi_c, truth.phi_j - 2e-3, 20, 17);
+  FitOptions o;
+  o.terms = 2;
+  const FitResult r = fit(FitKind::dst, d.phi, d.values, truth, o);
+  EXPECT_FALSE(r.covariance_ok);
+  for (const auto& p : r.parameters) EXPECT_TRUE(std::isnan(p.std_error)) << p.name;
+  EXPECT_LT(r.rms, 2.0 * kNoise);  // the curve itself is still fine
+}
+
 TEST(Fit, FittedTomlRoundTrips) {
   Preset preset = load_preset("hermes2016");
   const auto d = synthesize(FitKind::low, preset.steady, 0.2, 0.52, 20, 15);

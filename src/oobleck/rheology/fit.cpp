@@ -8,6 +8,7 @@
 
 #include <ceres/ceres.h>
 #include <fmt/format.h>
+#include <glog/logging.h>
 
 #include "oobleck/core/error.hpp"
 #include "oobleck/rheology/dilation.hpp"
@@ -132,6 +133,13 @@ std::vector<double> covariance(ceres::Problem& problem, const std::vector<const 
   o.algorithm_type = ceres::DENSE_SVD;  // reports rank deficiency instead of failing obscurely
   o.num_threads = 1;
   ceres::Covariance cov(o);
+  // Ceres logs a rank-deficient Jacobian through glog (LOG(ERROR)) besides returning false; the
+  // caller reports it (NaN standard errors), so silence glog for the call. Fits are serial.
+  struct QuietGlog {
+    int saved = FLAGS_minloglevel;
+    QuietGlog() { FLAGS_minloglevel = google::GLOG_FATAL; }
+    ~QuietGlog() { FLAGS_minloglevel = saved; }
+  } quiet;
   std::vector<std::pair<const double*, const double*>> pairs;
   for (std::size_t i = 0; i < blocks.size(); ++i) {
     for (std::size_t j = i; j < blocks.size(); ++j) pairs.emplace_back(blocks[i], blocks[j]);
