@@ -2,6 +2,7 @@
 # Regenerates the synthetic example data of docs/fitting.md (run from the repository root after building).
 set -euo pipefail
 B=./build/release/oobleck
+mkdir -p out/fit
 # 1. flow curves of the dhaene1993 set at 11 volume fractions (our "rheometer")
 $B rheology flow-curve --preset dhaene1993 --points 50 --out out/fit/flow_curves.csv \
   $(for p in 0.30 0.40 0.45 0.50 0.52 0.54 0.55 0.56 0.58 0.60 0.62; do echo --phi $p; done)
@@ -18,3 +19,7 @@ awk -F, 'BEGIN{srand(8)} NR>1 && $1<0.565 {if(!($1 in m)||$7>m[$1])m[$1]=$7}
    echo "$p,$($B rheology dst --preset dhaene1993 --phi $p --json | sed 's/.*"shear_rate_dst":\([^,}]*\).*/\1/')"
  done) | awk -F, 'BEGIN{srand(9)} NR==1{print;next}{printf "%s,%.4g\n",$1,$2*(1+0.04*(rand()-0.5))}' \
   > docs/fitting/dst_rates.csv
+for f in min_viscosity plateau_viscosity dst_rates; do
+  sed -i '1i # synthetic example: dhaene1993 (PMMA) from oobleck itself with +-2 % scatter; see docs/fitting.md' \
+    docs/fitting/$f.csv
+done
