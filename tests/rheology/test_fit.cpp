@@ -215,6 +215,8 @@ TEST(Fit, RejectsBadData) {
   EXPECT_THROW(fit(FitKind::low, phi, {2.0, -4.0, 9.0}, base), InputError);            // non-positive
   EXPECT_THROW(fit(FitKind::low, phi, {2.0, 4.0}, base), InputError);                  // size mismatch
   EXPECT_THROW(fit(FitKind::high, {0.2, 0.3, 0.6}, eta, base), InputError);            // phi >= base phi_j
+  EXPECT_THROW(fit(FitKind::high, {0.2, 0.3, base.phi_j - 1e-8}, eta, base), InputError);  // no room for phi_c
+  EXPECT_THROW(fit(FitKind::low, {0.2, 0.3, 1.0 - 1e-8}, eta, base), InputError);          // no room for phi_j
   EXPECT_THROW(fit(FitKind::dst, {0.45, 0.47, 0.3, 0.5, 0.51}, {1, 2, 3, 4, 5}, base), InputError);  // < phi_c
   try {
     FitOptions o;

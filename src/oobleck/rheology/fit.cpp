@@ -201,6 +201,12 @@ FitResult fit_viscosity(FitKind kind, const std::vector<double>& phi, const std:
     lo = phi_max + kStrict;
     hi = base.phi_j - kStrict;
   }
+  if (!(lo < hi)) {
+    throw InputError(fmt::format("{}: no admissible {}: it must exceed the largest data phi = {}{} and stay below {}",
+                                 options.where, kind == FitKind::low ? "phi_j" : "phi_c", phi_max,
+                                 kind == FitKind::low ? fmt::format(" and the base phi_c = {}", base.phi_c) : "",
+                                 kind == FitKind::low ? "1" : fmt::format("the base phi_j = {}", base.phi_j)));
+  }
   double x[2];
   viscosity_guess(phi, eta_r, base.mu_c, lo, hi, x[0], x[1]);
   x[0] = std::max(x[0], 2.0 * kAMin);
