@@ -1,10 +1,300 @@
-// `oobleck rheology fit`: placeholder until the Ceres fitting lands (owned by the fitting work).
+// `oobleck rheology fit`: fit the steady asymptotes of the model to rheometer data with Ceres
+// (model.md §2 "Fitting"; library part in src/oobleck/rheology/fit.hpp):
+//   --kind low : (a_0, phi_j) of E12 to minimum viscosities      (columns phi, viscosity | relative_viscosity)
+//   --kind high: (a_inf, phi_c) of E13 to plateau viscosities     (same columns)
+//   --kind dst : eta_B terms (phi_i, alpha_i) of E8 via E14        (columns phi, shear_rate_dst)
+// Writes a complete parameter file (the base set with the fitted values replaced, standard errors
+// as comments) that loads with --params in every other command.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <memory>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
 #include "cli_common.hpp"
 #include "oobleck/core/error.hpp"
+#include "oobleck/io/csv.hpp"
+#include "oobleck/io/output_file.hpp"
+#include "oobleck/rheology/fit.hpp"
+#include "oobleck/rheology/flow_curve.hpp"
 
 namespace oobleck::cli {
-void add_fit_command(CLI::App& rheology) {
-  auto* cmd = rheology.add_subcommand("fit", "fit model parameters to rheometer data (Ceres)");
-  cmd->callback([] { throw InputError("rheology fit is not implemented yet"); });
+namespace {
+namespace fs = std::filesystem;
+
+constexpr const char* kDefaultPreset = "hermes2016";
+
+/// Text safe inside a TOML basic string and a comment line: no quotes, backslashes, controls.
+std::string sanitize(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '"') out += '\'';
+    else if (c == '\\') out += '/';
+    else if (static_cast<unsigned char>(c) < 0x20) out += ' ';
+    else out += c;
+  }
+  return out;
 }
+
+std::string unit_of(const std::string& name) {
+  if (name.find("phi_i") != std::string::npos) return "[1/(Pa s)]";
+  return "[-]";
+}
+
+std::string fmt_se(double se) { return std::isfinite(se) ? fmt::format("{:.3g}", se) : "n/a"; }
+
+struct Data {
+  std::vector<double> phi, values;  ///< values: eta_r (low/high) or gamma_dot_DST [1/s] (dst)
+  std::string column;               ///< the CSV column the values came from
+};
+
+/// Reads phi and the kind's value column; checks the raw values (the library checks the rest).
+Data read_data(const std::string& path, rheology::FitKind kind, double eta_0) {
+  const io::CsvTable t = io::read_csv(path);
+  Data d;
+  if (!t.has_column("phi")) {
+    throw InputError(fmt::format("{}: missing column 'phi' (columns present: {}); expected phi,{}", path,
+                                 fmt::join(t.header, ", "),
+                                 kind == rheology::FitKind::dst ? "shear_rate_dst" : "viscosity"));
+  }
+  double scale = 1.0;
+  if (kind == rheology::FitKind::dst) {
+    if (!t.has_column("shear_rate_dst")) {
+      throw InputError(fmt::format("{}: missing column 'shear_rate_dst' [1/s] (columns present: {}); --kind dst "
+                                   "needs phi,shear_rate_dst",
+                                   path, fmt::join(t.header, ", ")));
+    }
+    d.column = "shear_rate_dst";
+  } else {
+    const bool visc = t.has_column("viscosity"), rel = t.has_column("relative_viscosity");
+    if (visc == rel) {
+      throw InputError(fmt::format("{}: {} (columns present: {}); --kind {} needs phi and exactly one of "
+                                   "viscosity [Pa s] or relative_viscosity [-]",
+                                   path, visc ? "both 'viscosity' and 'relative_viscosity' given" :
+                                                "missing column 'viscosity' or 'relative_viscosity'",
+                                   fmt::join(t.header, ", "), rheology::to_string(kind)));
+    }
+    d.column = visc ? "viscosity" : "relative_viscosity";
+    if (visc) scale = 1.0 / eta_0;  // eta_r = viscosity/eta_0
+  }
+  d.phi = t.column("phi");
+  const std::vector<double> raw = t.column(d.column);
+  for (std::size_t k = 0; k < raw.size(); ++k) {
+    if (!(d.phi[k] > 0.0 && d.phi[k] < 1.0)) {
+      throw InputError(fmt::format("{}: data row {}: column 'phi' = {}: must lie in (0, 1)", path, k + 1, d.phi[k]));
+    }
+    if (!(raw[k] > 0.0)) {
+      throw InputError(fmt::format("{}: data row {}: column '{}' = {}: must be positive", path, k + 1, d.column,
+                                   raw[k]));
+    }
+    d.values.push_back(raw[k] * scale);
+  }
+  return d;
+}
+
+/// Header comments of the fitted parameter file: what was fitted, with standard errors.
+std::string toml_header(const rheology::FitResult& r, const std::string& data, const std::string& base) {
+  std::string h = fmt::format("# oobleck parameter set fitted by: oobleck rheology fit --kind {} --data {}\n",
+                              rheology::to_string(r.kind), sanitize(data));
+  h += fmt::format("# base set: {}; every value not listed below is the base value (mu_c is never fitted)\n",
+                   sanitize(base));
+  h += "# fitted values with 1-sigma standard errors (Ceres covariance scaled by s^2 = 2 cost/(n - p)):\n";
+  for (const auto& p : r.parameters) {
+    h += fmt::format("#   {} = {:.8g} +- {} {}\n", p.name, p.value, fmt_se(p.std_error), unit_of(p.name));
+  }
+  h += fmt::format("# n = {} points, p = {} parameters, rms log residual = {:.4g}\n\n", r.n, r.p, r.rms);
+  return h;
+}
+
+/// Data (with the fitted model) and a fine model curve for tools/plot_fit.py, then the plot,
+/// written to a temporary PNG beside `png`; returns the temporary's path.
+std::string plot_fit(const rheology::FitResult& r, const Data& d, const std::string& title, const std::string& png) {
+  using rheology::FitKind;
+  const fs::path dir = fs::temp_directory_path();
+  const std::string stem = fmt::format("oobleck-fit-{}", ::getpid());
+  const std::string data_csv = (dir / (stem + "-data.csv")).string();
+  const std::string curve_csv = (dir / (stem + "-curve.csv")).string();
+  struct Cleanup {
+    std::vector<std::string> files;
+    ~Cleanup() {
+      std::error_code ec;
+      for (const auto& f : files) fs::remove(f, ec);
+    }
+  } cleanup{{data_csv, curve_csv}};
+
+  std::string s = "phi,data,model\n";
+  for (std::size_t k = 0; k < d.phi.size(); ++k) {
+    s += fmt::format("{},{},{}\n", num(d.phi[k]), num(d.values[k]),
+                     num(rheology::fit_model_value(r.kind, r.params, d.phi[k])));
+  }
+  io::write_file_atomically(data_csv, s, "plot data");
+
+  // Curve up to the asymptote phi_m (E12: phi_j, E13: phi_c, E14: phi_j), log-spaced in the gap.
+  const double phi_lo = *std::min_element(d.phi.begin(), d.phi.end());
+  const double phi_hi = *std::max_element(d.phi.begin(), d.phi.end());
+  const double phi_m = r.kind == FitKind::high ? r.params.phi_c : r.params.phi_j;
+  const double start = r.kind == FitKind::dst ? r.params.phi_c : std::max(0.0, phi_lo - 0.05 * (phi_m - phi_lo));
+  const double gap_hi = phi_m - start;
+  const double gap_lo = r.kind == FitKind::dst ? 0.5 * (phi_m - phi_hi) : std::min(0.5 * (phi_m - phi_hi), 1e-3 * gap_hi);
+  std::string c = "phi,model\n";
+  constexpr int kPoints = 300;
+  for (int k = 0; k < kPoints; ++k) {
+    const double gap = gap_hi * std::pow(gap_lo / gap_hi, double(k) / (kPoints - 1));
+    const double phi = phi_m - gap;
+    const double v = rheology::fit_model_value(r.kind, r.params, phi);
+    if (std::isfinite(v)) c += fmt::format("{},{}\n", num(phi), num(v));
+  }
+  io::write_file_atomically(curve_csv, c, "plot curve");
+
+  const std::string tmp = png + ".tmp.png";
+  try {
+    run_tool("plot_fit.py", {data_csv, curve_csv, "--kind", rheology::to_string(r.kind), "--phi-m", num(phi_m),
+                             "--title", title, tmp});
+  } catch (...) {
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw;
+  }
+  return tmp;
+}
+
+}  // namespace
+
+void add_fit_command(CLI::App& rheology) {
+  auto* cmd = rheology.add_subcommand(
+      "fit", "fit model parameters to rheometer data with Ceres: low (a_0, phi_j; E12), high (a_inf, phi_c; E13), "
+             "dst (eta_B terms; E14)");
+  struct Opts {
+    ParamsOption params;
+    std::string kind, data, out, png;
+    int terms = 0;
+    bool json = false;
+  };
+  auto o = std::make_shared<Opts>();
+  cmd->add_option("--kind", o->kind, "low | high | dst")->required();
+  cmd->add_option("--data", o->data,
+                  "CSV with columns phi,viscosity [Pa s] or phi,relative_viscosity (low, high); phi,shear_rate_dst "
+                  "[1/s] (dst)")
+      ->required();
+  o->params.add_to(cmd);
+  cmd->add_option("--out", o->out, "fitted parameter file (TOML) to write")->required();
+  cmd->add_option("--plot", o->png, "also plot data and fitted curve to this PNG");
+  auto* terms = cmd->add_option("--terms", o->terms,
+                                "dst only: number of eta_B terms to fit (default: as many as the base set has, or 1)");
+  cmd->add_flag("--json", o->json,
+                "print one JSON object {\"kind\", \"parameters\": {name: {\"value\", \"std_error\"}}, \"n\", \"rms\"}");
+  cmd->callback([o, terms] {
+    const rheology::FitKind kind = rheology::parse_fit_kind(o->kind, "--kind");
+    rheology::FitOptions options;
+    if (terms->count() > 0) {
+      if (kind != rheology::FitKind::dst) {
+        throw InputError(fmt::format("--terms = {}: only for --kind dst (not {})", o->terms, o->kind));
+      }
+      if (o->terms < 1) throw InputError(fmt::format("--terms = {}: must be >= 1", o->terms));
+      options.terms = o->terms;
+    }
+    const bool default_base = o->params.preset.empty() && o->params.params.empty();
+    rheology::Preset preset = o->params.load(kDefaultPreset);
+    std::string note;
+    if (default_base) {
+      note = fmt::format("no --preset or --params given: using the {} preset as the base parameter set",
+                         kDefaultPreset);
+      fmt::print(o->json ? stderr : stdout, "{}\n", note);
+    }
+    const Data d = read_data(o->data, kind, preset.steady.eta_0);
+    options.where = o->data;
+    rheology::validate_fit_data(kind, d.phi, d.values, preset.steady, options);
+    io::check_writable(o->out, "--out");
+    if (!o->png.empty()) io::check_writable(o->png, "--plot");
+
+    const rheology::FitResult r = rheology::fit(kind, d.phi, d.values, preset.steady, options);
+
+    const std::string base_desc = fmt::format("{} ({})", preset.name, preset.file);
+    rheology::Preset fitted = preset;
+    fitted.steady = r.params;
+    fitted.name = sanitize(fs::path(o->out).stem().string());
+    fitted.source = sanitize(fmt::format("oobleck rheology fit --kind {} to {}; base {}: {}", o->kind,
+                                         fs::path(o->data).filename().string(), preset.name, preset.source));
+    try {
+      rheology::validate(fitted, o->out);
+    } catch (const InputError& e) {
+      throw NumericalError(fmt::format("the fitted parameters break a rule: {}", e.what()));
+    }
+
+    std::string tmp_png;
+    if (!o->png.empty()) {
+      tmp_png = plot_fit(r, d, fmt::format("{}: fit --kind {} (base {})", fs::path(o->data).filename().string(),
+                                            o->kind, preset.name),
+                         o->png);
+    }
+    try {
+      io::write_file_atomically(o->out, toml_header(r, o->data, base_desc) + rheology::to_toml(fitted), "--out");
+    } catch (...) {
+      if (!tmp_png.empty()) {
+        std::error_code ec;
+        fs::remove(tmp_png, ec);
+      }
+      throw;
+    }
+    if (!tmp_png.empty()) fs::rename(tmp_png, o->png);
+
+    std::string warning;
+    if (r.rms > 0.1) {
+      const std::string hint =
+          kind == rheology::FitKind::dst
+              ? fmt::format("check the units (shear_rate_dst in 1/s), the base set (phi_c, phi_j, tau_star, eta_0 = "
+                            "{} Pa s) and the number of eta_B terms (--terms)",
+                            preset.steady.eta_0)
+              : fmt::format("check the units (viscosity in Pa s, eta_0 = {} Pa s of the base set) and that the "
+                            "points are {} viscosities",
+                            preset.steady.eta_0, kind == rheology::FitKind::low ? "minimum" : "plateau (maximum)");
+      warning = fmt::format("warning: rms log residual {:.3g} > 0.1 (more than 10 % scatter): the fitted {} "
+                            "asymptote does not describe these data well; {}",
+                            r.rms, rheology::to_string(kind), hint);
+    }
+    if (o->json) {
+      if (!warning.empty()) fmt::print(stderr, "{}\n", warning);
+      nlohmann::json params = nlohmann::json::object();
+      for (const auto& p : r.parameters) {
+        params[p.name] = {{"value", p.value},
+                          {"std_error", std::isfinite(p.std_error) ? nlohmann::json(p.std_error) : nlohmann::json()}};
+      }
+      nlohmann::json j = {{"kind", rheology::to_string(kind)},
+                          {"parameters", params},
+                          {"n", r.n},
+                          {"rms", r.rms},
+                          {"iterations", r.iterations},
+                          {"base", preset.name},
+                          {"out", o->out}};
+      if (!note.empty()) j["note"] = note;
+      fmt::print("{}\n", j.dump());
+      return;
+    }
+    fmt::print("base parameter set: {} [{} units]; mu_c = {} (fixed)\n", base_desc, preset.units,
+               preset.steady.mu_c);
+    fmt::print("fit --kind {} to {}: n = {} points, p = {} parameters; Ceres converged ({} iterations)\n", o->kind,
+               o->data, r.n, r.p, r.iterations);
+    std::size_t width = 0;
+    for (const auto& p : r.parameters) width = std::max(width, p.name.size());
+    for (const auto& p : r.parameters) {
+      const double rel = std::abs(p.std_error / p.value);
+      fmt::print("  {:<{}} = {:<12.6g} +- {:<10}  {:<11}{}\n", p.name, width, p.value, fmt_se(p.std_error),
+                 unit_of(p.name), std::isfinite(rel) ? fmt::format("({:.2g} %)", 100.0 * rel) : "");
+    }
+    if (!r.covariance_ok) {
+      fmt::print("  standard errors n/a: the parameters are not all identifiable from these data (rank-deficient "
+                 "Jacobian){}\n",
+                 kind == rheology::FitKind::dst ? "; fit fewer eta_B terms (--terms)" : "");
+    }
+    fmt::print("rms log residual = {:.4g} (n = {})\n", r.rms, r.n);
+    if (!warning.empty()) fmt::print("{}\n", warning);
+    fmt::print("wrote {}\n", o->out);
+    if (!o->png.empty()) fmt::print("wrote {}\n", o->png);
+  });
+}
+
 }  // namespace oobleck::cli
