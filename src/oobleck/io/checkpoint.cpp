@@ -117,7 +117,7 @@ void write_array(CheckpointWriter::Impl& impl, const std::string& path, const st
     throw std::invalid_argument(
         fmt::format("checkpoint array name '{}': use letters, digits, '_', '-', '.', '/' between parts", name));
   }
-  if (!impl.names.insert(name).second) {
+  if (impl.names.count(name) > 0) {
     throw std::invalid_argument(fmt::format("checkpoint '{}': array '{}' written twice", path, name));
   }
   if (shape.empty()) shape = {data.size()};
@@ -127,6 +127,7 @@ void write_array(CheckpointWriter::Impl& impl, const std::string& path, const st
     throw std::invalid_argument(
         fmt::format("checkpoint array '{}': shape holds {} values but {} were given", name, count, data.size()));
   }
+  impl.names.insert(name);
   std::vector<hsize_t> dims(shape.begin(), shape.end());
   h5::Handle space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr));
   h5::Handle dset(H5Dcreate2(impl.arrays.get(), name.c_str(), type, space.get(), impl.lcpl.get(), H5P_DEFAULT,

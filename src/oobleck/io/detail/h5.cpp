@@ -154,10 +154,8 @@ bool read_attribute(hid_t loc, const std::string& name, std::string& value) {
   if (H5Tget_class(type.get()) != H5T_STRING || H5Tis_variable_str(type.get()) > 0) return false;
   const std::size_t size = H5Tget_size(type.get());
   std::string buf(size, '\0');
-  Handle mem(H5Tcopy(H5T_C_S1));
-  H5Tset_size(mem.get(), size);
-  H5Tset_strpad(mem.get(), H5T_STR_NULLPAD);
-  if (H5Aread(attr.get(), mem.get(), buf.data()) < 0) return false;
+  // Read with the stored type itself (same size, padding and character set: no conversion).
+  if (H5Aread(attr.get(), type.get(), buf.data()) < 0) return false;
   const auto end = buf.find('\0');
   value = end == std::string::npos ? buf : buf.substr(0, end);
   return true;
