@@ -3,8 +3,8 @@
 
     /usr/bin/python3 tools/check_xdmf.py RUN/frames.xmf [--quiet]
 
-Checks the XML structure (Xdmf > Domain > temporal collection of spatial collections with a
-Time each, Polyvertex point grids with XY/XYZ geometry, 3DCoRectMesh node grids), that every
+Checks the XML structure (Xdmf > Domain > one temporal collection per block of Uniform grids
+with a Time each: Polyvertex point grids with XY/XYZ geometry, 3DCoRectMesh node grids), that every
 attribute's dimensions agree with its grid and its AttributeType, and that every HDF5 reference
 points to an existing HDF5 file. With h5py installed it also opens every dataset and compares
 its shape and type with the index; without h5py it checks the HDF5 signature of each file.
@@ -75,8 +75,10 @@ class Checker:
             d = h5[dset]
             if list(d.shape) != dims:
                 self.problem(where, f"dataset '{ref}' has shape {list(d.shape)}, index says {dims}")
-            if d.dtype.kind != "f" or d.dtype.itemsize != int(item.get("Precision", "4")):
-                self.problem(where, f"dataset '{ref}' has type {d.dtype}, index says Float/{item.get('Precision')}")
+            number = item.get("NumberType", "Float")
+            kind = {"Float": "f", "Int": "i", "UInt": "u", "Char": "i", "UChar": "u"}.get(number, "?")
+            if d.dtype.kind != kind or d.dtype.itemsize != int(item.get("Precision", "4")):
+                self.problem(where, f"dataset '{ref}' has type {d.dtype}, index says {number}/{item.get('Precision')}")
 
     def data_item(self, parent, where, expect=None):
         item = parent.find("DataItem")
@@ -136,6 +138,8 @@ class Checker:
                 return
             if n <= 0:
                 self.problem(where, "Polyvertex with no points (ParaView rejects it)")
+            if topo.find("DataItem") is not None:
+                self.data_item(topo, where + "/Topology", [n])
             gtype = geom.get("GeometryType")
             if gtype not in ("XY", "XYZ"):
                 self.problem(where, f"point geometry '{gtype}', expected XY or XYZ")
@@ -184,34 +188,38 @@ class Checker:
         if domain is None:
             self.problem("Xdmf", "no <Domain>")
             return
-        series = domain.findall("Grid")
-        if len(series) != 1 or series[0].get("CollectionType") != "Temporal":
-            self.problem("Domain", "expected exactly one temporal collection <Grid>")
-            return
-        last_time = None
-        for frame in series[0].findall("Grid"):
-            self.frames += 1
-            where = f"frame '{frame.get('Name')}'"
-            if frame.get("GridType") != "Collection" or frame.get("CollectionType") != "Spatial":
-                self.problem(where, "expected a spatial collection")
-            time = frame.find("Time")
-            try:
-                t = float(time.get("Value")) if time is not None else None
-            except (TypeError, ValueError):
-                t = None
-            if t is None:
-                self.problem(where, "no numeric <Time Value=...>")
-            elif last_time is not None and t < last_time:
-                self.problem(where, f"time {t} goes back from {last_time}")
-            else:
-                last_time = t
-            names = set()
-            for grid in frame.findall("Grid"):
-                name = grid.get("Name")
-                if name in names:
-                    self.problem(where, f"two grids named '{name}'")
-                names.add(name)
-                self.uniform(grid, f"{where}/{name}")
+        blocks = domain.findall("Grid")
+        if not blocks:
+            self.problem("Domain", "no <Grid>")
+        names = set()
+        for block in blocks:
+            name = block.get("Name")
+            where = f"block '{name}'"
+            if name in names:
+                self.problem(where, "two blocks with this name")
+            names.add(name)
+            if block.get("GridType") != "Collection" or block.get("CollectionType") != "Temporal":
+                self.problem(where, "expected a temporal collection")
+                continue
+            last_time = None
+            steps = block.findall("Grid")
+            self.frames = max(self.frames, len(steps))
+            for i, grid in enumerate(steps):
+                w = f"{where}[{i}]"
+                if grid.get("GridType", "Uniform") != "Uniform":
+                    self.problem(w, "expected a Uniform grid")
+                time = grid.find("Time")
+                try:
+                    t = float(time.get("Value")) if time is not None else None
+                except (TypeError, ValueError):
+                    t = None
+                if t is None:
+                    self.problem(w, "no numeric <Time Value=...>")
+                elif last_time is not None and t < last_time:
+                    self.problem(w, f"time {t} goes back from {last_time}")
+                else:
+                    last_time = t
+                self.uniform(grid, w)
 
 
 def main(argv):

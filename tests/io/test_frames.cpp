@@ -202,26 +202,32 @@ TEST(Frames, IndexReferencesExistingDatasetsWithMatchingDimensions) {
   const std::string xmf_path = writer.index_path();
   const std::string xmf = read_text(xmf_path);
   EXPECT_EQ(xmf.rfind("<?xml", 0), 0u);
-  EXPECT_EQ(count_of(xmf, R"(CollectionType="Temporal")"), 1u);
-  EXPECT_EQ(count_of(xmf, R"(CollectionType="Spatial")"), 3u);
-  EXPECT_EQ(count_of(xmf, "<Time Value="), 3u);
-  EXPECT_NE(xmf.find(R"(<Time Value="0.20000000000000001"/>)"), std::string::npos);
+  // One temporal collection per block (body "grains", "grid"), one Uniform grid per frame.
+  EXPECT_EQ(count_of(xmf, R"(CollectionType="Temporal")"), 2u);
+  EXPECT_NE(xmf.find(R"(<Grid Name="grains" GridType="Collection" CollectionType="Temporal">)"), std::string::npos);
+  EXPECT_NE(xmf.find(R"(<Grid Name="grid" GridType="Collection" CollectionType="Temporal">)"), std::string::npos);
+  EXPECT_EQ(count_of(xmf, R"(GridType="Uniform")"), 2u * 3u);
+  EXPECT_EQ(count_of(xmf, "<Time Value="), 2u * 3u);
+  EXPECT_EQ(count_of(xmf, R"(<Time Value="0.20000000000000001"/>)"), 2u);
   EXPECT_EQ(count_of(xmf, R"(TopologyType="Polyvertex" NumberOfElements="4")"), 3u);
   EXPECT_EQ(count_of(xmf, R"(AttributeType="Tensor6" Center="Node")"), 3u);
   EXPECT_EQ(count_of(xmf, R"(AttributeType="Scalar" Center="Node")"), 6u);
-  EXPECT_EQ(count_of(xmf, "<Grid "), 1u + 3u * 3u);
-  EXPECT_EQ(count_of(xmf, "</Grid>"), 1u + 3u * 3u);
+  EXPECT_EQ(count_of(xmf, "<Grid "), 2u + 2u * 3u);
+  EXPECT_EQ(count_of(xmf, "</Grid>"), 2u + 2u * 3u);
 
   const auto refs = hdf_refs(xmf_path);
-  ASSERT_EQ(refs.size(), 3u * 4u);  // position, phi, stress, grid mass
+  ASSERT_EQ(refs.size(), 3u * 5u);  // connectivity, position, phi, stress, grid mass
   for (const auto& [dims, ref] : refs) {
     const auto colon = ref.find(':');
     ASSERT_NE(colon, std::string::npos) << ref;
     const std::string file = dir.file(ref.substr(0, colon));
     ASSERT_TRUE(fs::exists(file)) << ref;
-    const auto data = read_h5_doubles(file, ref.substr(colon + 1));
+    const auto data = read_h5_doubles(file, ref.substr(colon + 1));  // converts ints too
     ASSERT_TRUE(data.ok) << ref;
     EXPECT_EQ(data.shape, dims) << ref;
+    if (ref.find("/connectivity") != std::string::npos) {
+      for (std::size_t i = 0; i < data.values.size(); ++i) EXPECT_EQ(data.values[i], static_cast<double>(i));
+    }
   }
 }
 
@@ -263,7 +269,7 @@ TEST(Frames, ResumeKeepsFramesUpToRestartStep) {
   FrameWriter w = FrameWriter::resume(dir.str(), 25);
   EXPECT_EQ(w.frames_written(), 3u);
   EXPECT_FALSE(fs::exists(w.frame_path(3)));
-  EXPECT_EQ(count_of(read_text(w.index_path()), "<Time Value="), 3u);
+  EXPECT_EQ(count_of(read_text(w.index_path()), "<Time Value="), 3u);  // one block, 3 frames
   const std::string p = w.write({0.27, 27, {PointCloud("grains", 2, pos)}, std::nullopt});
   EXPECT_EQ(p, w.frame_path(3));
   double step = 0;
@@ -300,6 +306,7 @@ TEST(Frames, EmptyBodyStaysOutOfTheIndex) {
   const std::string p = w.write({0.0, 0, {PointCloud("grains", 2, pos), empty}, std::nullopt});
   const std::string xmf = read_text(w.index_path());
   EXPECT_EQ(xmf.find("Name=\"solid\""), std::string::npos);
+  EXPECT_THROW(w.write({0.0, 1, {PointCloud("grid", 2, pos)}, std::nullopt}), std::invalid_argument);
   EXPECT_NE(xmf.find("Name=\"grains\""), std::string::npos);
   auto r = read_h5_doubles(p, "/bodies/solid/mass");
   EXPECT_TRUE(r.ok);

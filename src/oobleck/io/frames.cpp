@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <limits>
 #include <set>
 #include <stdexcept>
 
@@ -116,6 +117,7 @@ void check_fields(const FieldSet& set, const char* owner) {
 
 const std::string kFramePrefix = "frame_";
 const std::string kFrameSuffix = ".h5";
+constexpr const char* kGridBlock = "grid";
 
 }  // namespace
 
@@ -274,8 +276,20 @@ FrameWriter FrameWriter::resume(std::string run_dir, std::int64_t last_step, std
     if (!fs::exists(path)) break;
     h5::Handle file = h5::open_file_readonly(path);
     Entry e{};
-    if (!file.valid() || !h5::read_attribute(file.get(), "step", e.step) ||
-        !h5::read_attribute(file.get(), "time", e.time) || !h5::read_attribute(file.get(), "xdmf", e.xml)) {
+    std::string blocks;
+    bool ok = file.valid() && h5::read_attribute(file.get(), "step", e.step) &&
+              h5::read_attribute(file.get(), "time", e.time) && h5::read_attribute(file.get(), "blocks", blocks);
+    for (std::size_t pos = 0; ok && pos < blocks.size();) {
+      const std::size_t end = std::min(blocks.find('\n', pos), blocks.size());
+      const std::string block = blocks.substr(pos, end - pos);
+      pos = end + 1;
+      const std::string object = block == kGridBlock ? "/grid" : "/bodies/" + block;
+      h5::Handle g(H5Gopen2(file.get(), object.c_str(), H5P_DEFAULT));
+      std::string xml;
+      ok = g.valid() && h5::read_attribute(g.get(), "xdmf", xml);
+      e.blocks.emplace_back(block, std::move(xml));
+    }
+    if (!ok) {
       throw InputError(fmt::format("frame file '{}': not a readable oobleck frame (cannot resume its series)", path));
     }
     if (e.step > last_step) break;
@@ -295,10 +309,10 @@ std::string FrameWriter::write(const Frame& frame) {
   const std::size_t index = entries_.size();
   const std::string path = frame_path(index);
   const std::string rel = (fs::path(name_) / fs::path(path).filename()).string();  // relative to the .xmf
-  const std::string frame_name = fmt::format("{}{:06d}", kFramePrefix, index);
 
   std::set<std::string> body_names;
   for (const auto& b : frame.bodies) {
+    if (b.name() == kGridBlock) throw std::invalid_argument("body name 'grid' is reserved for the grid");
     if (!body_names.insert(b.name()).second) {
       throw std::invalid_argument(fmt::format("frame {}: body '{}' given twice", index, b.name()));
     }
@@ -306,10 +320,9 @@ std::string FrameWriter::write(const Frame& frame) {
   }
   if (frame.grid) check_fields(*frame.grid, "grid");
 
-  std::string xml;
-  xml += fmt::format("    <Grid Name=\"{}\" GridType=\"Collection\" CollectionType=\"Spatial\">\n", frame_name);
-  xml += fmt::format("      <Time Value=\"{:.17g}\"/>\n", frame.time);
-
+  const std::string time_xml = fmt::format("      <Time Value=\"{:.17g}\"/>\n", frame.time);
+  Entry entry{frame.step, frame.time, {}};
+  std::string block_list;
   const std::string tmp = fmt::format("{}.tmp-{}", path, ::getpid());
   try {
     h5::Handle file = h5::create_file(tmp);
@@ -327,19 +340,40 @@ std::string FrameWriter::write(const Frame& frame) {
         const auto buf = interleave(b.positions(), n, b.dim(), b.dim());
         h5::write_dataset(g.get(), "position", H5T_NATIVE_DOUBLE, pshape, buf.data());
       }
+      // Explicit vertex list 0..N-1: the Xdmf3 readers make no cells of a Polyvertex topology
+      // without one (points then do not render); the XDMF (2) reader accepts it too.
+      const bool small = n <= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
+      if (small) {
+        std::vector<std::int32_t> conn(n);
+        for (std::size_t i = 0; i < n; ++i) conn[i] = static_cast<std::int32_t>(i);
+        h5::write_dataset(g.get(), "connectivity", H5T_NATIVE_INT32, {n}, conn.data());
+      } else {
+        std::vector<std::int64_t> conn(n);
+        for (std::size_t i = 0; i < n; ++i) conn[i] = static_cast<std::int64_t>(i);
+        h5::write_dataset(g.get(), "connectivity", H5T_NATIVE_INT64, {n}, conn.data());
+      }
       h5::write_attribute(g.get(), "count", static_cast<std::int64_t>(n));
-      std::string bxml;
+      std::string xml;
       const std::string prefix = fmt::format("{}:/bodies/{}", rel, b.name());
-      bxml += fmt::format("      <Grid Name=\"{}\" GridType=\"Uniform\">\n", b.name());
-      bxml += fmt::format("        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"{}\" NodesPerElement=\"1\"/>\n", n);
-      bxml += fmt::format("        <Geometry GeometryType=\"{}\">\n", b.dim() == 2 ? "XY" : "XYZ");
-      bxml += fmt::format("          {}\n", hdf_item(pshape, prefix + "/position"));
-      bxml += "        </Geometry>\n";
-      for (const auto& f : b.fields()) write_field(g.get(), prefix, f, n, {n}, bxml, "        ");
-      bxml += "      </Grid>\n";
+      xml += fmt::format("    <Grid Name=\"{}\" GridType=\"Uniform\">\n", b.name());
+      xml += time_xml;
+      xml += fmt::format("      <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"{}\" NodesPerElement=\"1\">\n", n);
+      xml += fmt::format(
+          "        <DataItem Dimensions=\"{}\" NumberType=\"Int\" Precision=\"{}\" Format=\"HDF\">{}/connectivity</DataItem>\n",
+          n, small ? 4 : 8, prefix);
+      xml += "      </Topology>\n";
+      xml += fmt::format("      <Geometry GeometryType=\"{}\">\n", b.dim() == 2 ? "XY" : "XYZ");
+      xml += fmt::format("        {}\n", hdf_item(pshape, prefix + "/position"));
+      xml += "      </Geometry>\n";
+      for (const auto& f : b.fields()) write_field(g.get(), prefix, f, n, {n}, xml, "      ");
+      xml += "    </Grid>\n";
+      h5::write_attribute(g.get(), "xdmf", xml);
       // ParaView rejects a Polyvertex grid of zero points: an empty body stays in the HDF5 file
       // (so its fields are still listed) but not in the index of this frame.
-      if (n > 0) xml += bxml;
+      if (n > 0) {
+        entry.blocks.emplace_back(b.name(), std::move(xml));
+        block_list += b.name() + "\n";
+      }
     }
     if (frame.grid) {
       const NodeGrid& grid = *frame.grid;
@@ -353,26 +387,31 @@ std::string FrameWriter::write(const Frame& frame) {
                                                                       static_cast<std::int64_t>(nn[1]),
                                                                       static_cast<std::int64_t>(nn[2])});
       h5::write_attribute(g.get(), "dim", static_cast<std::int64_t>(grid.dim()));
-      // A 2D grid is written as one layer of a 3D mesh: ParaView places a 2DCoRectMesh in the
-      // y-z plane, away from the XY points; a 3DCoRectMesh with nz = 1 lies in the x-y plane.
+      // A 2D grid is written as one layer of a 3D mesh: VTK's XDMF readers place a
+      // 2DCoRectMesh in the y-z plane, away from the XY points; a 3DCoRectMesh with nz = 1
+      // lies in the x-y plane.
       const std::vector<std::uint64_t> lead{nn[2], nn[1], nn[0]};
-      xml += "      <Grid Name=\"grid\" GridType=\"Uniform\">\n";
-      xml += fmt::format("        <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"{}\"/>\n", dims_text(lead));
-      xml += "        <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n";
+      std::string xml;
+      xml += fmt::format("    <Grid Name=\"{}\" GridType=\"Uniform\">\n", kGridBlock);
+      xml += time_xml;
+      xml += fmt::format("      <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"{}\"/>\n", dims_text(lead));
+      xml += "      <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n";
       xml += fmt::format(
-          "          <DataItem Name=\"Origin\" Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" "
+          "        <DataItem Name=\"Origin\" Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" "
           "Format=\"XML\">{:.17g} {:.17g} {:.17g}</DataItem>\n",
           o[2], o[1], o[0]);
       xml += fmt::format(
-          "          <DataItem Name=\"Spacing\" Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" "
+          "        <DataItem Name=\"Spacing\" Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" "
           "Format=\"XML\">{:.17g} {:.17g} {:.17g}</DataItem>\n",
           h[2], h[1], h[0]);
-      xml += "        </Geometry>\n";
-      for (const auto& f : grid.fields()) write_field(g.get(), rel + ":/grid", f, grid.count(), lead, xml, "        ");
-      xml += "      </Grid>\n";
+      xml += "      </Geometry>\n";
+      for (const auto& f : grid.fields()) write_field(g.get(), rel + ":/grid", f, grid.count(), lead, xml, "      ");
+      xml += "    </Grid>\n";
+      h5::write_attribute(g.get(), "xdmf", xml);
+      entry.blocks.emplace_back(kGridBlock, std::move(xml));
+      block_list += std::string(kGridBlock) + "\n";
     }
-    xml += "    </Grid>\n";
-    h5::write_attribute(file.get(), "xdmf", xml);
+    h5::write_attribute(file.get(), "blocks", block_list);
     bodies.reset();
     if (!file.reset()) throw std::runtime_error("closing the file failed (disk full?)");
     fs::rename(tmp, path);
@@ -381,21 +420,31 @@ std::string FrameWriter::write(const Frame& frame) {
     fs::remove(tmp, ec);
     throw std::runtime_error(fmt::format("cannot write frame file '{}': {}", path, e.what()));
   }
-  entries_.push_back({frame.step, frame.time, std::move(xml)});
+  entries_.push_back(std::move(entry));
   write_index();
   return path;
 }
 
 void FrameWriter::write_index() const {
+  // One temporal collection per block (body or grid), in order of first appearance: ParaView
+  // then shows one block per body with the same name at every time.
+  std::vector<std::string> order;
+  for (const auto& e : entries_)
+    for (const auto& [block, xml] : e.blocks)
+      if (std::find(order.begin(), order.end(), block) == order.end()) order.push_back(block);
   std::string s;
   s += "<?xml version=\"1.0\" ?>\n";
   s += "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n";
   s += "<Xdmf Version=\"2.0\">\n";
-  s += "  <Domain>\n";
-  s += fmt::format("  <Grid Name=\"{}\" GridType=\"Collection\" CollectionType=\"Temporal\">\n", name_);
-  for (const auto& e : entries_) s += e.xml;
-  s += "  </Grid>\n";
-  s += "  </Domain>\n";
+  s += "<Domain>\n";
+  for (const auto& block : order) {
+    s += fmt::format("  <Grid Name=\"{}\" GridType=\"Collection\" CollectionType=\"Temporal\">\n", block);
+    for (const auto& e : entries_)
+      for (const auto& [b, xml] : e.blocks)
+        if (b == block) s += xml;
+    s += "  </Grid>\n";
+  }
+  s += "</Domain>\n";
   s += "</Xdmf>\n";
   write_file_atomically(index_path(), s, "frames index");
 }

@@ -2,8 +2,8 @@
 // Run frames for ParaView: HDF5 heavy data, one file per frame, plus one XDMF (.xmf) index.
 //
 // Layout of a run folder (see docs/output.md):
-//   RUN/frames.xmf                 XDMF 2 temporal collection, rewritten atomically after every
-//                                  frame, so a run killed at any moment leaves an index that opens
+//   RUN/frames.xmf                 XDMF 2 index, rewritten atomically after every frame, so a
+//                                  run killed at any moment leaves an index that opens
 //   RUN/frames/frame_000000.h5     one self-contained HDF5 file per frame, written to a temporary
 //   RUN/frames/frame_000001.h5     name and renamed: a frame file is complete or absent
 //
@@ -11,13 +11,19 @@
 // lose the frame being written; HDF5 files that are open for writing when a process dies are
 // often unreadable as a whole.
 //
+// The index holds one temporal collection per block (each body, and "grid"), each a list of
+// Uniform grids with their Time, so ParaView shows one block per body under the same name at
+// every time step.
+//
 // Inside a frame file:
 //   /                    attributes: time (double), step (int64), format "oobleck-frame-1",
-//                                    xdmf (this frame's XDMF <Grid> element, used on resume)
+//                                    blocks (names of the blocks in the index, one per line)
 //   /bodies/NAME/position          (N, dim) double, dim = 2 or 3
+//   /bodies/NAME/connectivity      (N) int32 0..N-1 (int64 above 2^31 points): Polyvertex cells
 //   /bodies/NAME/FIELD             (N) scalar, (N, 3) vector, (N, 6) tensor6, (N, 9) tensor
 //   /grid/FIELD                    (nz, ny, nx[, c]) node values, x fastest; nz = 1 in 2D
 //   /grid                          attributes: origin, spacing (x, y, z order), nodes (nx, ny, nz)
+//   /bodies/NAME, /grid            attribute xdmf: the block's <Grid> element (used on resume)
 // Every field dataset carries an attribute `type` = Scalar | Vector | Tensor6 | Tensor.
 //
 // The writer depends on nothing but spans of doubles, so it serves any solver layout:
@@ -29,6 +35,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace oobleck::io {
@@ -156,7 +163,7 @@ class FrameWriter {
   struct Entry {
     std::int64_t step;
     double time;
-    std::string xml;  // the frame's <Grid> element
+    std::vector<std::pair<std::string, std::string>> blocks;  // (body or "grid", its <Grid> element)
   };
   FrameWriter(std::string run_dir, std::string name, bool fresh);
   void write_index() const;
