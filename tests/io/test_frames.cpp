@@ -341,3 +341,30 @@ TEST(Frames, BadInputIsRefused) {
   EXPECT_THROW(w.write({0, 0, {b, b}, std::nullopt}), std::invalid_argument);
   EXPECT_EQ(w.frames_written(), 0u);
 }
+
+// ParaView itself (when installed: pvbatch) opens the index with its XDMF and Xdmf3 readers and
+// finds every block, point, cell and field.
+TEST(Frames, ParaViewOpensTheIndex) {
+  if (!fs::exists("/usr/bin/pvbatch")) GTEST_SKIP() << "ParaView (pvbatch) not installed";
+  TempDir dir;
+  const std::vector<double> pos{0, 0, 1, 0, 0, 1}, p{1, 2, 3}, v{1, 0, 0, 1, 1, 1}, m(6, 1.0);
+  FrameWriter w(dir.str());
+  for (int k = 0; k < 2; ++k) {
+    PointCloud b("grains", 2, pos);
+    b.scalar("pressure", p).vector("velocity", 2, v);
+    NodeGrid g(2, {0, 0, 0}, {0.5, 0.5, 0}, {3, 2, 1});
+    g.scalar("mass", m);
+    w.write({0.1 * k, k, {b}, g});
+  }
+  const std::string out = dir.file("probe.txt");
+  const std::string cmd = "/usr/bin/pvbatch " + std::string(OOBLECK_SOURCE_DIR) + "/tools/paraview_probe.py '" +
+                          w.index_path() + "' > '" + out + "' 2>/dev/null";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  const std::string probe = read_text(out);
+  // Both readers, both times, both blocks; points as cells; 2D grid in the x-y plane.
+  EXPECT_EQ(count_of(probe, R"("class": "vtkUnstructuredGrid", "points": 3, "cells": 3)"), 4u) << probe;
+  EXPECT_EQ(count_of(probe, R"("points": 6, "cells": 2, "bounds": [0.0, 1.0, 0.0, 0.5, 0.0, 0.0])"), 4u) << probe;
+  EXPECT_EQ(count_of(probe, R"("reader": "xdmf2", "time": 0.1, "block": "grains")"), 1u) << probe;
+  EXPECT_EQ(count_of(probe, R"("arrays": {"pressure": 1, "velocity": 3})"), 4u) << probe;
+  EXPECT_EQ(count_of(probe, R"("velocity": [1.0, 0.0, 0.0])"), 4u) << probe;
+}
