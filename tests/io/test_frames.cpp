@@ -368,3 +368,29 @@ TEST(Frames, ParaViewOpensTheIndex) {
   EXPECT_EQ(count_of(probe, R"("arrays": {"pressure": 1, "velocity": 3})"), 4u) << probe;
   EXPECT_EQ(count_of(probe, R"("velocity": [1.0, 0.0, 0.0])"), 4u) << probe;
 }
+
+// A long index is rewritten less often than every frame but stays valid, and flush() (or the
+// destructor) completes it.
+TEST(Frames, LongIndexStaysValidAndIsCompletedByFlush) {
+  TempDir dir;
+  const std::vector<double> pos{0, 0, 1, 1}, val{1, 2};
+  const int frames = 150;  // 40 fields x 150 frames: an index of well over 1 MiB
+  {
+    FrameWriter w(dir.str());
+    for (int k = 0; k < frames; ++k) {
+      PointCloud b("grains", 2, pos);
+      for (int f = 0; f < 40; ++f) b.scalar("field_" + std::to_string(f), val);
+      w.write({1e-3 * k, k, {b}, std::nullopt});
+      if (k % 25 == 24) {
+        const std::string xmf = read_text(w.index_path());
+        EXPECT_EQ(count_of(xmf, "<Grid "), count_of(xmf, "</Grid>"));
+        EXPECT_NE(xmf.find("</Xdmf>"), std::string::npos);
+      }
+    }
+    EXPECT_GT(fs::file_size(w.index_path()), FrameWriter::kIndexAlwaysBytes);
+    w.flush();
+    EXPECT_EQ(count_of(read_text(w.index_path()), "<Time Value="), static_cast<std::size_t>(frames));
+    w.write({1.0, 1000, {PointCloud("grains", 2, pos)}, std::nullopt});
+  }  // the destructor completes the index
+  EXPECT_EQ(count_of(read_text(dir.file("frames.xmf")), "<Time Value="), static_cast<std::size_t>(frames + 1));
+}

@@ -421,11 +421,55 @@ std::string FrameWriter::write(const Frame& frame) {
     throw std::runtime_error(fmt::format("cannot write frame file '{}': {}", path, e.what()));
   }
   entries_.push_back(std::move(entry));
-  write_index();
+  index_stale_ = true;
+  const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - index_written_).count();
+  if (index_bytes_ < kIndexAlwaysBytes || since >= 20.0 * index_seconds_) write_index();
   return path;
 }
 
-void FrameWriter::write_index() const {
+FrameWriter::FrameWriter(FrameWriter&& o) noexcept
+    : run_dir_(std::move(o.run_dir_)),
+      name_(std::move(o.name_)),
+      entries_(std::move(o.entries_)),
+      index_stale_(o.index_stale_),
+      index_bytes_(o.index_bytes_),
+      index_seconds_(o.index_seconds_),
+      index_written_(o.index_written_) {
+  o.index_stale_ = false;
+}
+
+FrameWriter& FrameWriter::operator=(FrameWriter&& o) noexcept {
+  if (this != &o) {
+    try {
+      flush();
+    } catch (...) {
+    }
+    run_dir_ = std::move(o.run_dir_);
+    name_ = std::move(o.name_);
+    entries_ = std::move(o.entries_);
+    index_stale_ = o.index_stale_;
+    index_bytes_ = o.index_bytes_;
+    index_seconds_ = o.index_seconds_;
+    index_written_ = o.index_written_;
+    o.index_stale_ = false;
+  }
+  return *this;
+}
+
+FrameWriter::~FrameWriter() {
+  try {
+    flush();
+  } catch (...) {
+    // A destructor must not throw; the index then lists the frames up to its last rewrite.
+  }
+}
+
+void FrameWriter::flush() {
+  if (index_stale_) write_index();
+}
+
+void FrameWriter::write_index() {
+  const auto start = std::chrono::steady_clock::now();
   // One temporal collection per block (body or grid), in order of first appearance: ParaView
   // then shows one block per body with the same name at every time.
   std::vector<std::string> order;
@@ -447,6 +491,10 @@ void FrameWriter::write_index() const {
   s += "</Domain>\n";
   s += "</Xdmf>\n";
   write_file_atomically(index_path(), s, "frames index");
+  index_written_ = std::chrono::steady_clock::now();
+  index_seconds_ = std::chrono::duration<double>(index_written_ - start).count();
+  index_bytes_ = s.size();
+  index_stale_ = false;
 }
 
 }  // namespace oobleck::io
