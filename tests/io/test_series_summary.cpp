@@ -64,6 +64,15 @@ TEST(Series, ResumeDropsRowsAfterTheRestartPoint) {
   }
   EXPECT_EQ(read_text(path), "step,e\n0,0\n10,0.5\n20,1\n25,9\n");
   EXPECT_THROW(SeriesWriter::resume(path, {"step", "energy"}, 20), InputError);
+  // A row cut by a kill (no line break) is dropped; a malformed complete row is an error.
+  std::ofstream(path, std::ios::app) << "30,1.2";
+  {
+    SeriesWriter s = SeriesWriter::resume(path, {"step", "e"}, 100);
+    EXPECT_EQ(s.rows_written(), 4u);
+  }
+  EXPECT_EQ(read_text(path), "step,e\n0,0\n10,0.5\n20,1\n25,9\n");
+  std::ofstream(path, std::ios::app) << "30\n";
+  EXPECT_THROW(SeriesWriter::resume(path, {"step", "e"}, 100), InputError);
   EXPECT_THROW(SeriesWriter::resume(dir.file("none.csv"), {"step"}, 20), InputError);
 }
 

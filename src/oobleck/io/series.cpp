@@ -1,5 +1,6 @@
 #include "oobleck/io/series.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -49,31 +50,42 @@ SeriesWriter::SeriesWriter(std::string path, std::vector<std::string> columns)
 
 SeriesWriter SeriesWriter::resume(std::string path, std::vector<std::string> columns, double keep_until) {
   const std::string header = header_line(columns);
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(fmt::format("series '{}': cannot resume, the file does not exist", path));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string text = ss.str();
+  in.close();
+  // A run killed while writing a row leaves a last line without its line break: drop it.
+  if (!text.empty() && text.back() != '\n') text.erase(text.rfind('\n') == std::string::npos ? 0 : text.rfind('\n') + 1);
+  std::istringstream lines(text);
   std::string line;
-  if (!std::getline(in, line) || line != header) {
+  if (!std::getline(lines, line) || line != header) {
     throw InputError(fmt::format("series '{}': cannot resume, its header '{}' differs from '{}'", path, line, header));
   }
   std::string kept = header + "\n";
   std::size_t rows = 0;
-  while (std::getline(in, line)) {
+  while (std::getline(lines, line)) {
     if (line.empty()) continue;
+    const auto fields = static_cast<std::size_t>(std::count(line.begin(), line.end(), ',')) + 1;
     const std::string first = line.substr(0, line.find(','));
     double key = 0;
+    bool ok = fields == columns.size();
     try {
       std::size_t used = 0;
       key = std::stod(first, &used);
-      if (used != first.size()) throw std::invalid_argument(first);
+      ok = ok && used == first.size();
     } catch (const std::exception&) {
-      throw InputError(fmt::format("series '{}': cannot resume, row {} starts with '{}', not a number", path,
-                                   rows + 2, first));
+      ok = false;
+    }
+    if (!ok) {
+      throw InputError(fmt::format("series '{}': cannot resume, row {} ('{}') is not {} numbers", path, rows + 2,
+                                   line, columns.size()));
     }
     if (key > keep_until) break;
     kept += line + "\n";
     ++rows;
   }
-  in.close();
   write_file_atomically(path, kept, "series");
   std::FILE* f = std::fopen(path.c_str(), "a");
   if (f == nullptr) throw InputError(fmt::format("series '{}': cannot open for appending", path));
