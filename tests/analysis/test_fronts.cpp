@@ -168,6 +168,28 @@ TEST(IntrusionFronts, NoFrontBeforeThePlugForms) {
   EXPECT_DOUBLE_EQ(p.transverse_r_m, kRadius);
 }
 
+TEST(IntrusionFronts, TipGapSkipsEmptyNodesInsideTheIntruder) {
+  // Tip at 29.7 mm; the nodes inside the intruder (z > tip, r <= R) carry no material: u_z = 0.
+  const Synthetic syn{2.0, 1.0};
+  IntrusionFrame fr = syn.frame(0.0015);
+  ASSERT_NEAR(fr.tip_z_m, 0.0297, 1e-12);
+  for (std::size_t j = 0; j < fr.field.ny; ++j)
+    for (std::size_t i = 0; i < fr.field.nx; ++i)
+      if (fr.field.y(j) > fr.tip_z_m && fr.field.x(i) <= kRadius + 1e-12) fr.field.at(i, j) = 0.0;
+  FrontGeometry g = geometry();
+  const FrontPosition at_tip = measure_front(fr.field, fr.tip_z_m, velocity_front(kV0), g);
+  EXPECT_FALSE(at_tip.longitudinal_found);  // 0.3 x 1 + 0.7 x 0 interpolated at the tip
+  EXPECT_FALSE(at_tip.transverse_found);    // same at r = R on the tip-depth line
+  g.tip_gap_m = 0.5e-3;           // longitudinal search from 29.2 mm
+  g.transverse_offset_m = 0.5e-3;  // transverse line at 29.2 mm
+  const FrontPosition gap = measure_front(fr.field, fr.tip_z_m, velocity_front(kV0), g);
+  ASSERT_TRUE(gap.longitudinal_found);
+  EXPECT_NEAR(gap.longitudinal_ahead_m, syn.ahead(0.0015), 0.01 * kH);
+  EXPECT_NEAR(gap.transverse_from_edge_m, syn.edge(0.0015), 0.01 * kH);
+  g.tip_gap_m = -1e-3;
+  EXPECT_THROW(measure_front(fr.field, fr.tip_z_m, velocity_front(kV0), g), InputError);
+}
+
 TEST(IntrusionFronts, FarthestSearchSkipsAGap) {
   // Along the axis: plug, a noisy dip below the threshold, then another patch above it.
   Synthetic syn{2.0, 1.0};

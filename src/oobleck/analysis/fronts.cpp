@@ -52,6 +52,9 @@ void check_geometry(const FrontGeometry& g, const GridField2D& field, const char
                                  what, g.axis_r_m, field.origin_x, field.x_max()));
   if (!std::isfinite(g.transverse_offset_m))
     throw InputError(fmt::format("{}: transverse offset = {} m must be finite", what, g.transverse_offset_m));
+  if (!(std::isfinite(g.tip_gap_m) && g.tip_gap_m >= 0.0) || !(std::isfinite(g.edge_gap_m) && g.edge_gap_m >= 0.0))
+    throw InputError(fmt::format("{}: tip gap = {} m and edge gap = {} m must be finite and >= 0", what, g.tip_gap_m,
+                                 g.edge_gap_m));
 }
 
 bool same_grid(const GridField2D& a, const GridField2D& b) {
@@ -74,22 +77,24 @@ FrontPosition measure_front(const GridField2D& field, double tip_z_m, const Fron
   // Longitudinal: the axis column, search coordinate s = d (z - z_tip).
   {
     const std::vector<double> column = field.column_at(geometry.axis_r_m, "measure_front: axis column");
-    const double g_tip = sample_line(column, field.origin_y, field.h, tip_z_m, "measure_front: tip z") * inv_scale;
+    const double s0 = geometry.tip_gap_m;
+    const double g_tip =
+        sample_line(column, field.origin_y, field.h, tip_z_m + d * s0, "measure_front: tip z (+ gap)") * inv_scale;
     std::vector<double> s, g;
     const double eps = 1e-9 * field.h;
     for (std::size_t n = 0; n < field.ny; ++n) {
       const std::size_t j = d > 0 ? n : field.ny - 1 - n;
       const double sj = d * (field.y(j) - tip_z_m);
-      if (sj > eps) {
+      if (sj > s0 + eps) {
         s.push_back(sj);
         g.push_back(column[j] * inv_scale);
       }
     }
-    const LineCrossing c = search_front(0.0, g_tip, s, g, criterion.threshold, geometry.search);
+    const LineCrossing c = search_front(s0, g_tip, s, g, criterion.threshold, geometry.search);
     out.longitudinal_found = c.found;
     out.longitudinal_at_boundary = c.at_end;
-    out.longitudinal_ahead_m = c.position;
-    out.longitudinal_z_m = tip_z_m + d * c.position;
+    out.longitudinal_ahead_m = c.found ? c.position : 0.0;
+    out.longitudinal_z_m = tip_z_m + d * out.longitudinal_ahead_m;
   }
 
   // Transverse: the row at the tip depth, search coordinate s = r - R.
@@ -97,21 +102,23 @@ FrontPosition measure_front(const GridField2D& field, double tip_z_m, const Fron
     const double z_line = tip_z_m + d * geometry.transverse_offset_m;
     const std::vector<double> row = field.row_at(z_line, "measure_front: transverse line at the tip depth");
     const double radius = geometry.intruder_radius_m;
-    const double g_edge = sample_line(row, field.origin_x, field.h, radius, "measure_front: edge r") * inv_scale;
+    const double s0 = geometry.edge_gap_m;
+    const double g_edge =
+        sample_line(row, field.origin_x, field.h, radius + s0, "measure_front: edge r (+ gap)") * inv_scale;
     std::vector<double> s, g;
     const double eps = 1e-9 * field.h;
     for (std::size_t i = 0; i < field.nx; ++i) {
       const double si = field.x(i) - radius;
-      if (si > eps) {
+      if (si > s0 + eps) {
         s.push_back(si);
         g.push_back(row[i] * inv_scale);
       }
     }
-    const LineCrossing c = search_front(0.0, g_edge, s, g, criterion.threshold, geometry.search);
+    const LineCrossing c = search_front(s0, g_edge, s, g, criterion.threshold, geometry.search);
     out.transverse_found = c.found;
     out.transverse_at_boundary = c.at_end;
-    out.transverse_from_edge_m = c.position;
-    out.transverse_r_m = radius + c.position;
+    out.transverse_from_edge_m = c.found ? c.position : 0.0;
+    out.transverse_r_m = radius + out.transverse_from_edge_m;
   }
   return out;
 }

@@ -14,7 +14,8 @@
 // - Longitudinal front: on the axis column (r = axis_r), walking from the tip in the direction
 //   of motion, the point where g first drops below the threshold (contiguous search; or the
 //   deepest node with g >= threshold, `FrontSearch::farthest`), linearly interpolated between
-//   nodes; the value at the tip is interpolated between the two rows bracketing z_tip.
+//   nodes; the value at the tip is interpolated between the two rows bracketing z_tip (the
+//   search may start a gap ahead of the tip / beyond the edge, FrontGeometry::tip_gap_m).
 //   Reported as z_front [m], as `ahead` = direction * (z_front - z_tip) >= 0, the distance of the
 //   front ahead of the tip [m], and as the lab-frame penetration `depth` = direction * (z_front -
 //   z_ref) [m], z_ref = the tip's z in the first frame unless set. v_fl is the slope of depth
@@ -27,8 +28,8 @@
 //   Reported as r_front [m] and as `from_edge` = r_front - R [m]; v_ft is the slope of either vs
 //   time and k_t = v_ft / v_0.
 // - A front that never drops below the threshold before the grid ends is placed at the last
-//   node and flagged `at_boundary`; where g < threshold already at the tip (edge) there is no
-//   front: `found` is false and the position is the tip (edge).
+//   node and flagged `at_boundary`; where g < threshold already at the tip (edge), or at the
+//   gap's end, there is no front: `found` is false and the position is the tip (edge).
 #include <cstddef>
 #include <limits>
 #include <vector>
@@ -60,6 +61,12 @@ struct FrontGeometry {
   double intruder_radius_m = 0.005;  ///< R: the transverse search starts at r = R [m]
   double axis_r_m = 0.0;             ///< r of the longitudinal search column [m]
   double transverse_offset_m = 0.0;  ///< transverse line at z_tip + direction * offset [m]
+  /// Start the longitudinal search this far ahead of the tip, z_tip + direction * tip_gap [m]
+  /// (e.g. half a cell when nodes inside the intruder carry no material velocity); distances
+  /// are still measured from the tip.
+  double tip_gap_m = 0.0;
+  /// Start the transverse search at r = R + edge_gap [m]; distances still from the edge R.
+  double edge_gap_m = 0.0;
   FrontSearch search = FrontSearch::contiguous;
 };
 
