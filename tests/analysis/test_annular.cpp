@@ -1,0 +1,168 @@
+// S1 annular shear: Newtonian profile, profile extraction at bob angles, a rigid band growing at a
+// known speed, flow stop.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "oobleck/analysis/annular.hpp"
+#include "oobleck/core/error.hpp"
+
+using namespace oobleck::analysis;
+using oobleck::InputError;
+
+namespace {
+constexpr double kR0 = 0.0125, kRo = 0.0485, kUi = 0.084, kH = 1e-3;
+
+AnnularGeometry geometry() {
+  AnnularGeometry g;
+  g.bob_radius_m = kR0;
+  g.outer_radius_m = kRo;
+  g.bob_speed_m_per_s = kUi;
+  g.sample_z_m = 0.0035;
+  return g;
+}
+
+// scenes.md S1 grid offset to r_0: 36 cells in r; a few rows in z are enough here.
+GridField2D grid() {
+  GridField2D f;
+  f.origin_x = kR0;
+  f.h = kH;
+  f.nx = 37;
+  f.ny = 5;
+  f.values.assign(f.nx * f.ny, 0.0);
+  return f;
+}
+
+double newtonian(double r) {
+  return kUi * kR0 * (kRo * kRo / r - r) / (kRo * kRo - kR0 * kR0);
+}
+
+// Rigid rotation out to r_f, then v/(omega r) falls linearly (width 4 mm) through 0.5 at r_f.
+ShearFrame band_frame(double t, double r_front) {
+  ShearFrame fr;
+  fr.time_s = t;
+  fr.v_theta = grid();
+  const double omega = kUi / kR0;
+  for (std::size_t j = 0; j < fr.v_theta.ny; ++j)
+    for (std::size_t i = 0; i < fr.v_theta.nx; ++i) {
+      const double r = fr.v_theta.x(i);
+      fr.v_theta.at(i, j) = omega * r * std::clamp(0.5 - (r - r_front) / 4e-3, 0.0, 1.0);
+    }
+  return fr;
+}
+}  // namespace
+
+TEST(AnnularShear, NewtonianProfileMeetsBothWalls) {
+  const NewtonianAnnulus n = newtonian_annulus(kR0, kUi, kRo);
+  EXPECT_NEAR(n.v_theta(kR0), kUi, 1e-15);
+  EXPECT_NEAR(n.v_theta(kRo), 0.0, 1e-15);
+  for (double r : {0.015, 0.03, 0.045}) EXPECT_NEAR(n.v_theta(r), newtonian(r), 1e-15);
+  // Torque balance: r^2 tau_r_theta = const, tau ~ r d(v/r)/dr = -2 B / r^2.
+  EXPECT_LT(n.A_per_s, 0.0);
+  EXPECT_GT(n.B_m2_per_s, 0.0);
+  EXPECT_THROW(newtonian_annulus(kRo, kUi, kR0), InputError);
+}
+
+TEST(AnnularShear, DistanceFromNewtonianProfile) {
+  std::vector<double> r, v;
+  for (int i = 0; i <= 36; ++i) {
+    r.push_back(kR0 + i * kH);
+    v.push_back(newtonian(r.back()) / kUi);
+  }
+  EXPECT_NEAR(newtonian_distance(r, v, kR0, kRo), 0.0, 1e-14);
+  for (double& x : v) x += 0.03;
+  EXPECT_NEAR(newtonian_distance(r, v, kR0, kRo), 0.03, 1e-12);
+  EXPECT_THROW(newtonian_distance(r, std::vector<double>(3, 0.0), kR0, kRo), InputError);
+}
+
+TEST(AnnularShear, ProfilesAtBobAnglesInterpolateInTime) {
+  // v_theta = Newtonian(r) * t / 0.05 s, frames every 2 ms: linear in time, so exact.
+  std::vector<ShearFrame> frames;
+  for (int k = 0; k <= 25; ++k) {
+    ShearFrame fr;
+    fr.time_s = k * 2e-3;
+    fr.v_theta = grid();
+    for (std::size_t j = 0; j < fr.v_theta.ny; ++j)
+      for (std::size_t i = 0; i < fr.v_theta.nx; ++i)
+        fr.v_theta.at(i, j) = newtonian(fr.v_theta.x(i)) * fr.time_s / 0.05;
+    frames.push_back(fr);
+  }
+  const AnnularGeometry g = geometry();
+  const std::vector<ShearProfile> p = surface_profiles(frames, g, {0.0, 0.1, 0.2, 0.31});
+  ASSERT_EQ(p.size(), 4u);
+  for (const ShearProfile& q : p) {
+    EXPECT_NEAR(q.time_s, q.angle_rad * kR0 / kUi, 1e-15);
+    ASSERT_EQ(q.r_m.size(), 37u);
+    for (std::size_t i = 0; i < q.r_m.size(); ++i)
+      EXPECT_NEAR(q.v_over_ui[i], newtonian(q.r_m[i]) / kUi * q.time_s / 0.05, 1e-12);
+  }
+  // theta = 0.31 rad -> t = 46.1 ms: profile = 0.922 x Newtonian, distance 0.078 x |N/u_i|_2.
+  EXPECT_GT(newtonian_distance(p[3], g), 0.0);
+  EXPECT_LT(newtonian_distance(p[3], g), newtonian_distance(p[1], g));
+  EXPECT_THROW(surface_profiles(frames, g, {0.5}), InputError);  // t = 74 ms > last frame
+}
+
+TEST(AnnularShear, RigidBandGrowsAtAKnownSpeed) {
+  // r_f = r_0 + 2 mm + 0.05 m/s t: reaches the outer wall (48.5 mm) at t = 0.68 s.
+  std::vector<ShearFrame> frames;
+  for (int k = 0; k <= 40; ++k) {
+    const double t = k * 0.02;
+    frames.push_back(band_frame(t, kR0 + 2e-3 + 0.05 * t));
+  }
+  const AnnularGeometry g = geometry();
+  const std::vector<ShearFront> fronts = jammed_front_series(frames, g);
+  for (std::size_t k = 0; k < 30; ++k) {
+    ASSERT_TRUE(fronts[k].found);
+    EXPECT_NEAR(fronts[k].radius_m, kR0 + 2e-3 + 0.05 * frames[k].time_s, 0.01 * kH);
+  }
+  EXPECT_TRUE(fronts.back().at_wall);
+  FrontFitOptions o;
+  o.wall_margin_m = 2.5e-3;
+  const LinearFit fit = front_speed(fronts, g, o);
+  EXPECT_NEAR(fit.slope, 0.05, 1e-9);
+  EXPECT_NEAR(fit.r_squared, 1.0, 1e-12);
+  EXPECT_EQ(fit.points, 32u);  // t = 0 ... 0.62 s (r_f = 45.5 mm); at 0.64 s the front is 2 mm from the wall
+  EXPECT_EQ(front_radius_series(fronts).size(), 41u);
+
+  const FlowStop stop = flow_stop_time(frames, g, 1e-6, 0.5e-3);
+  ASSERT_TRUE(stop.time_s.has_value());
+  EXPECT_NEAR(*stop.time_s, 0.68, 1e-12);
+  EXPECT_TRUE(stop.by_front);
+  EXPECT_FALSE(stop.by_velocity);
+}
+
+TEST(AnnularShear, FlowStopsWhenTheGapComesToRest) {
+  std::vector<ShearFrame> frames;
+  for (int k = 0; k <= 10; ++k) {
+    ShearFrame fr;
+    fr.time_s = 0.1 * k;
+    fr.v_theta = grid();
+    for (std::size_t j = 0; j < fr.v_theta.ny; ++j) {
+      fr.v_theta.at(0, j) = kUi;  // the bob keeps its prescribed speed
+      for (std::size_t i = 1; i < fr.v_theta.nx; ++i)
+        fr.v_theta.at(i, j) = k < 3 ? newtonian(fr.v_theta.x(i)) : 1e-9;
+    }
+    frames.push_back(fr);
+  }
+  const FlowStop stop = flow_stop_time(frames, geometry(), 1e-6);
+  ASSERT_TRUE(stop.time_s.has_value());
+  EXPECT_NEAR(*stop.time_s, 0.3, 1e-12);
+  EXPECT_TRUE(stop.by_velocity);
+  EXPECT_FALSE(stop.by_front);
+  EXPECT_FALSE(flow_stop_time(std::vector<ShearFrame>(frames.begin(), frames.begin() + 3), geometry(), 1e-6)
+                   .time_s.has_value());
+}
+
+TEST(AnnularShear, RejectsBadInput) {
+  std::vector<ShearFrame> frames{band_frame(0.0, 0.02), band_frame(0.0, 0.021)};
+  EXPECT_THROW(jammed_front_series(frames, geometry()), InputError);  // equal times
+  AnnularGeometry g = geometry();
+  g.outer_radius_m = 0.06;  // beyond the grid
+  EXPECT_THROW(jammed_front(frames[0], g), InputError);
+  g = geometry();
+  g.bob_speed_m_per_s = 0.0;
+  EXPECT_THROW(jammed_front(frames[0], g), InputError);
+  EXPECT_THROW(surface_profiles({}, geometry(), {0.1}), InputError);
+  EXPECT_THROW(front_speed({}, geometry()), InputError);
+}
