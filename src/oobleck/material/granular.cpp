@@ -130,18 +130,107 @@ GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& 
   bool converged = true;
   int iterations = 0;
   double residual = 0.0;
+  const double g_max = tau_tr / Gdt;   // gamma_dot^p at which tau_bar = 0 (radial return)
+  const double dil = Kdt * K_3_ * phi;  // d p/d gamma_dot at p -> 0 (I_m -> infinity: beta -> K_3 phi)
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+
+  // Friction side of E21 at (gamma_dot, p, I_m): max((mu_p + beta) p, 0), with E20 written as
+  // mu_p p = mu_q(I_m) p + (5/2)(phi/a) eta_0 gamma_dot/I_m.
+  auto friction = [&](double gg, double pp, double uu) {
+    if (!(pp > 0.0)) return 0.0;
+    if (!(uu > 0.0)) return std::max((mu_q(0.0) + beta_of(0.0)) * pp, 0.0);
+    return std::max((mu_q(uu) + beta_of(uu)) * pp + visc * gg / uu, 0.0);
+  };
+
+  // ---- General shear solve in gamma_dot (used for p_tr <= 0 and as the fallback of the fast path).
+  // Inner: for fixed gamma_dot the pressure balance R_a(p) = p - p_tr - K dt gamma_dot beta(I_m(gamma_dot, p))
+  // is strictly increasing in p (beta decreases with p), root in (0, p_tr + K dt K_3 phi gamma_dot].
+  auto p_of = [&](double gg, double& uu, bool& ok) -> double {
+    ok = true;
+    if (!(gg > 0.0)) {
+      uu = 0.0;
+      return std::max(p_tr, 0.0);
+    }
+    if (p_tr + dil * gg <= 0.0) {  // no contact pressure even with full dilatancy
+      uu = kInf;
+      return 0.0;
+    }
+    const double Q = Q_of(gg), ck = Kdt * gg;
+    double plo = 0.0, phigh = p_tr + dil * gg, x = phigh;
+    ok = false;
+    for (int k = 1; k <= cap; ++k) {
+      ++iterations;
+      const double um = std::sqrt(Q / x);
+      const double Ra = x - p_tr - ck * beta_of(um);
+      if (std::fabs(Ra) <= 1e-15 * (x + std::fabs(p_tr))) {
+        ok = true;
+        break;
+      }
+      const double dRa = 1.0 + ck * dbeta_of(um) * um / (2.0 * x);
+      if (Ra > 0.0) phigh = x; else plo = x;
+      double nx = x - Ra / dRa;
+      const bool newton = nx > plo && nx < phigh;
+      if (!newton) nx = 0.5 * (plo + phigh);
+      if ((newton && std::fabs(nx - x) <= tol * x) || (phigh - plo) <= tol * phigh) {
+        x = nx;
+        ok = true;
+        break;
+      }
+      x = nx;
+    }
+    uu = std::sqrt(Q / x);
+    return x;
+  };
+  // Outer: R(gamma_dot) = tau_tr - G dt gamma_dot - friction, R(glo) > 0 >= R(ghi); Illinois.
+  auto solve_g = [&](double glo, double ghi) {
+    bool ok_in = true, all_ok = true;
+    double pp = 0.0, uu = 0.0;
+    auto R_g = [&](double gg) {
+      pp = p_of(gg, uu, ok_in);
+      all_ok = all_ok && ok_in;
+      return tau_tr - Gdt * gg - friction(gg, pp, uu);
+    };
+    double Rlo = R_g(glo), Rhi = R_g(ghi);
+    double gg = ghi, R = Rhi;
+    bool done = false;
+    int side = 0;
+    for (int k = 1; k <= cap && !done; ++k) {
+      ++iterations;
+      gg = (Rlo - Rhi) > 0.0 ? (glo * Rhi - ghi * Rlo) / (Rhi - Rlo) : 0.5 * (glo + ghi);
+      if (!(gg > glo && gg < ghi)) gg = 0.5 * (glo + ghi);
+      R = R_g(gg);
+      if (std::fabs(R) <= 1e-14 * tau_tr) break;
+      if (R > 0.0) {
+        glo = gg;
+        Rlo = R;
+        if (side == 1) Rhi *= 0.5;
+        side = 1;
+      } else {
+        ghi = gg;
+        Rhi = R;
+        if (side == -1) Rlo *= 0.5;
+        side = -1;
+      }
+      done = (ghi - glo) <= tol * ghi;
+    }
+    g = gg;
+    p = pp;
+    u = uu;
+    residual = std::fabs(R) / tau_tr;
+    converged = all_ok && residual <= 1e-9;
+  };
 
   if (p_tr > 0.0) {
     // -------- compressive trial: elastic, shear (f_1), or compaction (f_1 + f_3) --------
     const double mu0 = mu_q(0.0);
-    const bool f3_trial_active = phi < phi_m;                              // E23: g(phi) p_tr > 0
+    const bool f3_trial_active = phi < phi_m;                                      // E23: g(phi) p_tr > 0
     const double f1_trial = tau_tr - std::max((mu0 + beta_of(0.0)) * p_tr, 0.0);  // E21 at gamma_dot = 0
     if (!f3_trial_active && f1_trial <= 0.0) {
       regime = GranularRegime::kElastic;
       tau = tau_tr;
       p = p_tr;
     } else {
-      // Shear branch parametrised by u = I_m >= u_eq (beta >= 0, xi_dot_2 = 0): for given u the
+      // Fast path, parametrised by u = I_m >= u_eq (beta >= 0, xi_dot_2 = 0): for given u the
       // pressure balance p = p_tr + K dt beta(u) gamma_dot with p = Q(gamma_dot)/u^2 is a quadratic
       // in gamma_dot with one positive root; R(u) = tau_tr - G dt gamma_dot - (mu_p + beta) p is the
       // E21 residual (decreasing in u, see docs/granular.md).
@@ -193,11 +282,9 @@ GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& 
         regime = g > 0.0 ? GranularRegime::kShearCompaction : GranularRegime::kCompaction;
       } else {
         // -------- f_1 only: root of R(u) on [u_lo, u_hi] --------
-        double lo = u_eq, hi = 0.0;
-        double R_lo = e_lo.R;
+        double lo = u_eq, hi;
         // Upper bracket: with beta >= 0, gamma_dot(u) >= the beta = 0 root, so gamma_dot(u_hi) >= gamma_max
-        // = tau_tr/(G dt) when Q(gamma_max)/u_hi^2 <= p_tr; there R <= -(mu_p + beta) p < 0.
-        const double g_max = tau_tr / Gdt;
+        // when Q(gamma_max)/u_hi^2 <= p_tr; there R <= -(mu_p + beta) p < 0.
         hi = std::max(u_eq, std::sqrt(Q_of(g_max) / p_tr)) * (1.0 + 1e-12) + 1e-300;
         // Initial guess: rigid-plastic, viscous balance tau_tr/p_tr = mu_q + beta(u) + (5/4)(phi/a) u
         // (drop G dt, K dt): c1 a u^2 + (c1 - r a) u - (r + K_3 phi_m) = 0.
@@ -214,44 +301,40 @@ GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& 
         }
         Eval e{};
         converged = false;
-        double scale = tau_tr;
         for (iterations = 1; iterations <= cap; ++iterations) {
           e = eval(x);
-          if (e.R > 0.0) {
-            lo = x;
-            R_lo = e.R;
-          } else {
-            hi = x;
+          if (std::fabs(e.R) <= 1e-14 * tau_tr) {
+            converged = true;
+            break;
           }
-          double next = (e.dR < 0.0) ? x - e.R / e.dR : 0.5 * (lo + hi);
-          if (!(next > lo && next < hi)) {
-            // bisection, geometric when the bracket spans decades
-            next = (lo > 0.0 && hi > 4.0 * lo) ? std::sqrt(lo * hi) : 0.5 * (lo + hi);
-          }
-          const bool small_step = std::fabs(next - x) <= tol * std::fabs(x);
-          const bool small_bracket = (hi - lo) <= tol * hi;
-          x = next;
-          if (small_step || small_bracket || std::fabs(e.R) <= 1e-15 * scale) {
+          if (e.R > 0.0) lo = x; else hi = x;
+          double next = (e.dR < 0.0) ? x - e.R / e.dR : -1.0;
+          const bool newton = next > lo && next < hi;
+          if (!newton) next = (lo > 0.0 && hi > 4.0 * lo) ? std::sqrt(lo * hi) : 0.5 * (lo + hi);
+          if ((newton && std::fabs(next - x) <= tol * x) || (hi - lo) <= tol * hi) {
+            x = next;
             e = eval(x);
             converged = true;
             break;
           }
+          x = next;
         }
-        (void)R_lo;
-        u = x;
-        g = e.g;
-        p = e.p;
+        residual = std::fabs(e.R) / tau_tr;
+        if (converged && residual <= 1e-10) {
+          u = x;
+          g = e.g;
+          p = e.p;
+        } else {
+          // u is ill-conditioned here (gamma_dot(u) steep where dilatancy dominates p_tr): solve in gamma_dot
+          solve_g(e_lo.g, g_max);
+        }
         // tau_bar from the friction side of E21: accurate even when G dt g >> tau_bar
-        tau = u > 0.0 ? std::min((mu_q(u) + beta_of(u)) * p + visc * g / u, tau_tr) : std::min(tau_tr, (mu0 + beta_of(0.0)) * p);
-        residual = std::fabs(e.R) / std::max(scale, 1e-300);
-        if (!converged) iterations = cap;
+        tau = std::min(friction(g, p, u), tau_tr);
         regime = GranularRegime::kShear;
       }
     }
   } else {
     // -------- p_tr <= 0: separated (f_2 active) unless shear dilatancy builds pressure --------
-    const double g_max = tau_tr / Gdt;
-    const double dil = Kdt * K_3_ * phi;  // d p/d gamma_dot at p = 0 (I_m -> infinity: beta = K_3 phi)
     if (!(tau_tr > 0.0) || !(p_tr + dil * g_max > 0.0)) {
       regime = (tau_tr > 0.0 || p_tr < 0.0) ? GranularRegime::kSeparated : GranularRegime::kElastic;
       g = tau_tr > 0.0 ? g_max : 0.0;
@@ -259,79 +342,9 @@ GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& 
       p = 0.0;
       xi1 = std::max(-p_tr / Kdt - K_3_ * phi * g, 0.0);  // E22: p = p_tr + K dt (beta g + xi_1) = 0
     } else {
-      // Flow with p > 0 created by dilatancy: outer Illinois solve in gamma_dot on [g_0, g_max],
-      // inner monotone Newton for p (E18, E19 pressure balance); rare path.
-      auto p_of = [&](double gg, double& uu, int& its, bool& ok) {
-        const double Q = Q_of(gg);
-        const double ck = Kdt * gg;
-        const double p_hi = p_tr + ck * K_3_ * phi;  // beta <= K_3 phi
-        // R_a(pp) = pp - p_tr - ck beta(sqrt(Q/pp)), increasing in pp.
-        double plo = 0.0, phigh = p_hi, x = p_hi;
-        ok = false;
-        for (int k = 1; k <= cap; ++k) {
-          ++its;
-          const double um = std::sqrt(Q / x);
-          const double Ra = x - p_tr - ck * beta_of(um);
-          const double dRa = 1.0 + ck * dbeta_of(um) * um / (2.0 * x);
-          if (Ra > 0.0) phigh = x; else plo = x;
-          double nx = x - Ra / dRa;
-          if (!(nx > plo && nx < phigh)) nx = 0.5 * (plo + phigh);
-          if (std::fabs(nx - x) <= tol * x || (phigh - plo) <= tol * phigh || Ra == 0.0) {
-            x = nx;
-            ok = true;
-            break;
-          }
-          x = nx;
-        }
-        uu = std::sqrt(Q / x);
-        return x;
-      };
-      auto R_of = [&](double gg, double& pp, double& uu, int& its, bool& ok) {
-        if (gg <= 0.0 || p_tr + dil * gg <= 0.0) {
-          pp = 0.0;
-          uu = 0.0;
-          ok = true;
-          return tau_tr - Gdt * gg;
-        }
-        pp = p_of(gg, uu, its, ok);
-        return tau_tr - Gdt * gg - (mu_q(uu) + beta_of(uu)) * pp - visc * gg / uu;
-      };
-      double glo = std::max(-p_tr / dil, 0.0), ghi = g_max;
-      double pp = 0.0, uu = 0.0;
-      bool ok_in = true, all_ok = true;
-      double Rlo = R_of(glo, pp, uu, iterations, ok_in);
-      double Rhi = R_of(ghi, pp, uu, iterations, ok_in);
-      all_ok = all_ok && ok_in;
-      int side = 0;
-      converged = false;
-      double gg = glo;
-      for (int k = 1; k <= cap; ++k) {
-        ++iterations;
-        gg = (Rlo - Rhi) != 0.0 ? (glo * Rhi - ghi * Rlo) / (Rhi - Rlo) : 0.5 * (glo + ghi);
-        if (!(gg > glo && gg < ghi)) gg = 0.5 * (glo + ghi);
-        const double R = R_of(gg, pp, uu, iterations, ok_in);
-        all_ok = all_ok && ok_in;
-        if (R > 0.0) {
-          glo = gg;
-          Rlo = R;
-          if (side == 1) Rhi *= 0.5;
-          side = 1;
-        } else {
-          ghi = gg;
-          Rhi = R;
-          if (side == -1) Rlo *= 0.5;
-          side = -1;
-        }
-        if ((ghi - glo) <= tol * ghi || std::fabs(R) <= 1e-14 * tau_tr) {
-          converged = all_ok;
-          residual = std::fabs(R) / tau_tr;
-          break;
-        }
-      }
-      g = gg;
-      p = pp;
-      u = uu;
-      tau = (p > 0.0 && u > 0.0) ? std::min((mu_q(u) + beta_of(u)) * p + visc * g / u, tau_tr) : 0.0;
+      // flow with p > 0 created by dilatancy (rare path)
+      solve_g(std::max(-p_tr / dil, 0.0), g_max);
+      tau = std::min(friction(g, p, u), tau_tr);
       regime = p > 0.0 ? GranularRegime::kShear : GranularRegime::kSeparated;
       if (p <= 0.0) xi1 = std::max(-p_tr / Kdt - K_3_ * phi * g, 0.0);
     }
