@@ -55,3 +55,59 @@ TEST(SteadyConvergence, RateControlledMatchesClosedForm) {
     EXPECT_LT(test::rel(last.granular_pressure, cf.granular_pressure), 0.01) << c.preset << " " << c.rate;
   }
 }
+
+namespace {
+material::ShearResult shear_stress_run(const material::GranularLaw& law, double phi, double stress, double duration,
+                                       double dt) {
+  material::ShearOptions o;
+  o.phi = phi;
+  o.stress_controlled = true;
+  o.shear_stress = stress;
+  o.duration = duration;
+  o.dt = dt;
+  o.samples = 10;
+  return material::run_shear(law, o);
+}
+}  // namespace
+
+// Stress control lands on the same closed-form curve, including the unstable-under-rate-control
+// DST branch (d gamma_dot/d tau < 0) of hermes2016 at phi = 0.48 (phi_c < phi < phi_j, Delta = 0).
+TEST(SteadyConvergence, StressControlledMatchesClosedFormIncludingDstBranch) {
+  struct SCase {
+    const char* preset;
+    double phi, stress, duration, dt;
+    bool dst_branch;
+  };
+  const SCase cases[] = {
+      {"hermes2016", 0.48, 1.0, 100.0, 0.02, false},
+      {"hermes2016", 0.48, 50.0, 200.0, 0.02, true},
+      {"hermes2016", 0.40, 20.0, 10.0, 1e-3, false},
+      {"dhaene1993", 0.55, 10.0, 20.0, 2e-3, false},
+  };
+  for (const SCase& c : cases) {
+    const material::GranularLaw law(test::preset(c.preset, 1e-8));
+    const auto r = shear_stress_run(law, c.phi, c.stress, c.duration, c.dt);
+    const auto& last = r.samples.back();
+    const auto cf = test::steady_at_f(law.steady(), c.phi, last.f);  // closed form at the reached f
+    std::printf("%s phi=%.2f S=%g: rate %.6g/%.6g tau %.6g/%.6g taub %.6g/%.6g p %.6g/%.6g f %.6g\n", c.preset,
+                c.phi, c.stress, last.shear_rate, cf.shear_rate, c.stress, cf.shear_stress,
+                last.granular_shear_stress, cf.granular_shear_stress, last.granular_pressure, cf.granular_pressure,
+                last.f);
+    EXPECT_LT(test::rel(cf.shear_stress, c.stress), 0.01) << c.preset << " S " << c.stress;
+    EXPECT_LT(test::rel(last.shear_rate, cf.shear_rate), 0.01) << c.preset << " S " << c.stress;
+    EXPECT_LT(test::rel(last.granular_shear_stress, cf.granular_shear_stress), 0.01) << c.preset;
+    EXPECT_LT(test::rel(last.granular_pressure, cf.granular_pressure), 0.01) << c.preset;
+    // the f reached is the closed-form f at this stress (E11 swept in f; tau(f) is increasing)
+    {
+      double lo = 0.0, hi = rheology::f_upper(law.steady(), c.phi);
+      for (int k = 0; k < 200; ++k) {
+        const double m = 0.5 * (lo + hi);
+        (test::steady_at_f(law.steady(), c.phi, m).shear_stress < c.stress ? lo : hi) = m;
+      }
+      EXPECT_LT(test::rel(last.f, 0.5 * (lo + hi)), 0.01) << c.preset << " S " << c.stress;
+    }
+    const auto cf2 = test::steady_at_f(law.steady(), c.phi, last.f * 1.001);
+    const bool negative_slope = cf2.shear_rate < cf.shear_rate && cf2.shear_stress > cf.shear_stress;
+    EXPECT_EQ(negative_slope, c.dst_branch) << c.preset << " S " << c.stress;
+  }
+}
