@@ -202,6 +202,24 @@ void reduced_relax_ode(const GranularLaw& law, double phi, double span, double& 
   }
 }
 
+double steady_rate_at_stress(const rheology::SteadyParams& s, double phi, double stress) {
+  rheology::validate_phi(s, phi, "phi");
+  const double fu = rheology::f_upper(s, phi);
+  auto at = [&](double f) { return rheology::steady_point(s, phi, f, fu - f); };
+  const double tau_lo = at(1e-12 * fu).shear_stress;
+  if (!(stress > tau_lo)) {
+    throw InputError(fmt::format("shear stress {} Pa is below the smallest steady stress {} Pa at phi = {}", stress,
+                                 tau_lo, phi));
+  }
+  double lo = 1e-12 * fu, hi = fu * (1.0 - 1e-12);
+  if (at(hi).shear_stress < stress) return at(hi).shear_rate;
+  for (int k = 0; k < 200 && hi - lo > 1e-15 * hi; ++k) {
+    const double m = 0.5 * (lo + hi);
+    (at(m).shear_stress < stress ? lo : hi) = m;
+  }
+  return at(0.5 * (lo + hi)).shear_rate;
+}
+
 RelaxResult run_relax(const GranularLaw& law, const RelaxOptions& o, const Progress& progress) {
   RelaxResult r;
   r.G = law.G();
@@ -210,30 +228,41 @@ RelaxResult run_relax(const GranularLaw& law, const RelaxOptions& o, const Progr
   GranularState st;
   Eigen::Matrix3d D, W;
   simple_shear_rates(o.shear_rate, D, W);
-  const double dt_pre = 0.02 / o.shear_rate;
+  const double rate_est = o.stress_controlled ? steady_rate_at_stress(law.steady(), o.phi, o.shear_stress) : o.shear_rate;
+  // steps of at most 2% strain that also resolve the structure rate K_0 gamma_dot (1 + H) of E24
+  auto pre_dt = [&](double tau_est) {
+    const double x = tau_est / law.steady().tau_star;
+    return std::min(0.02, 0.1 / (law.granular().K_0 * (1.0 + x * std::sqrt(x)))) / rate_est;
+  };
+  double dt_pre = o.stress_controlled ? pre_dt(o.shear_stress) : 0.02 / rate_est;
   GranularUpdate u;
   double prev_tau = -1.0, prev_f = -1.0;
   int quiet = 0;
   long k = 0;
   const long k_max = 2000000;
   for (; k < k_max; ++k) {
-    u = checked_update(law, st, D, W, dt_pre, o.phi);
+    if (o.stress_controlled) {
+      stress_controlled_step(law, st, o.phi, dt_pre, o.shear_stress, u);
+    } else {
+      u = checked_update(law, st, D, W, dt_pre, o.phi);
+    }
     const bool still = std::fabs(u.tau_bar - prev_tau) <= 1e-11 * u.tau_bar && std::fabs(st.f - prev_f) <= 1e-12;
     quiet = still ? quiet + 1 : 0;
     prev_tau = u.tau_bar;
     prev_f = st.f;
+    if (!o.stress_controlled && k == 200) dt_pre = std::min(dt_pre, pre_dt(u.tau_bar));
     if (quiet >= 50 && k > 500) break;
   }
   if (k >= k_max) {
-    throw NumericalError(fmt::format("point relax: pre-shear at {} 1/s did not reach a steady state within {} "
+    throw NumericalError(fmt::format("point relax: pre-shear (rate {} 1/s) did not reach a steady state within {} "
                                      "strain (tau_bar = {} Pa, f = {})",
-                                     o.shear_rate, 0.02 * static_cast<double>(k_max), u.tau_bar, st.f));
+                                     rate_est, 0.02 * static_cast<double>(k_max), u.tau_bar, st.f));
   }
   if (u.tau_bar <= 0.0 || u.regime == GranularRegime::kSeparated) {
     throw NumericalError(fmt::format("point relax: the pre-sheared state carries no granular stress (regime {}, "
                                      "tau_bar = {} Pa) at phi = {}", regime_name(u.regime), u.tau_bar, o.phi));
   }
-  r.preshear_strain = 0.02 * static_cast<double>(k + 1);
+  r.preshear_strain = rate_est * dt_pre * static_cast<double>(k + 1);
   r.tau_bar_0 = u.tau_bar;
   r.f_0 = st.f;
   r.p_0 = u.p;

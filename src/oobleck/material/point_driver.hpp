@@ -68,7 +68,9 @@ double stress_controlled_step(const GranularLaw& law, GranularState& state, doub
 /// Relaxation after cessation of steady shear.
 struct RelaxOptions {
   double phi = 0.0;         ///< [-]
-  double shear_rate = 0.0;  ///< pre-shear rate [1/s]
+  double shear_rate = 0.0;  ///< pre-shear rate [1/s] (rate-controlled pre-shear)
+  bool stress_controlled = false;  ///< pre-shear at imposed mixture shear stress instead
+  double shear_stress = 0.0;       ///< pre-shear mixture shear stress [Pa] (stress control)
   double duration = 0.0;    ///< relaxation time span after cessation [s]
   double dt = 0.0;          ///< first relaxation step [s]; <= 0: 1/20 of the initial relaxation time
   double growth = 0.02;     ///< dt = max(dt0, growth * t) after cessation (log-time resolution)
@@ -89,6 +91,10 @@ struct RelaxResult {
   double preshear_strain = 0.0;
   std::vector<RelaxSample> samples;
 };
+
+/// Closed-form steady shear rate at mixture shear stress `stress` (E11 swept in f; tau(f) is
+/// increasing), used to size pre-shear steps. Throws InputError if stress is out of range.
+double steady_rate_at_stress(const rheology::SteadyParams& s, double phi, double stress);
 
 /// Pre-shear to steady state (coarse steps: the backward-Euler return map has the exact steady
 /// state for any dt), then D = W = 0. `law` carries G and K_0.
