@@ -298,6 +298,11 @@ GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& 
                                                       : -2.0 * qc / (qb + std::sqrt(disc)))
                                         : 0.5 * (lo + hi);
           if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
+          // Near a steady state the root sits just above u_eq: a Newton step from the lower end is better.
+          if (e_lo.dR < 0.0) {
+            const double xn = lo - e_lo.R / e_lo.dR;
+            if (xn > lo && xn < x) x = xn;
+          }
         }
         Eval e{};
         converged = false;
