@@ -111,3 +111,23 @@ TEST(SteadyConvergence, StressControlledMatchesClosedFormIncludingDstBranch) {
     EXPECT_EQ(negative_slope, c.dst_branch) << c.preset << " S " << c.stress;
   }
 }
+
+// xi_dot_eps > 0 (Brownian/electrostatic structure decay, E7/E24) shifts the steady structure; the
+// run follows the closed form, whose E10 root rheology::steady_point solves separately.
+TEST(SteadyConvergence, RateControlledWithStructureDecay) {
+  rheology::Preset P = test::preset("hermes2016", 1e-8);
+  P.steady.xi_dot_eps = 2.0;
+  const material::GranularLaw law(P);
+  for (double rate : {1.0, 10.0}) {
+    const auto r = shear_rate_run(law, 0.44, rate, 60.0);
+    const auto& last = r.samples.back();
+    const double f_cf = test::steady_f_at_rate(law.steady(), 0.44, rate, last.f);
+    const auto cf = test::steady_at_f(law.steady(), 0.44, f_cf);
+    EXPECT_LT(test::rel(last.f, f_cf), 0.01) << rate;
+    EXPECT_LT(test::rel(last.granular_shear_stress, cf.granular_shear_stress), 0.01) << rate;
+    EXPECT_LT(test::rel(last.granular_pressure, cf.granular_pressure), 0.01) << rate;
+    // and the decay matters: f is below the xi_dot_eps = 0 value
+    const rheology::Preset P0 = test::preset("hermes2016", 1e-8);
+    EXPECT_LT(f_cf, 0.99 * test::steady_f_at_rate(P0.steady, 0.44, rate, last.f)) << rate;
+  }
+}
