@@ -168,13 +168,13 @@ struct ReducedRhs {
   void operator()(double tau, double f, double& dtau, double& df, double& rate_scale) const {
     const rheology::SteadyParams& s = law.steady();
     const double gap = rheology::phi_m_gap(s, rheology::f_jam(s, phi) - f);  // phi_m(f) - phi (E1)
-    const double c = rheology::granular_viscosity(phi, rheology::a_of_f(s, f), gap, s.mu_c);
-    const double gdp = tau / (c * law.eta_0());
+    const double c = gap > 0.0 ? rheology::granular_viscosity(phi, rheology::a_of_f(s, f), gap, s.mu_c) : 0.0;
+    const double gdp = gap > 0.0 ? tau / (c * law.eta_0()) : 0.0;  // jammed (phi_m <= phi): no flow
     dtau = -law.G() * gdp;
     const double x = tau / s.tau_star;
     const double K0 = law.granular().K_0;
     df = K0 * gdp * x * std::sqrt(x) * (fm - f) - K0 * (gdp + tau * inv_eta_B + s.xi_dot_eps) * f;  // E24
-    rate_scale = law.G() / (c * law.eta_0()) + K0 * (gdp * (1.0 + x * std::sqrt(x)) + tau * inv_eta_B + s.xi_dot_eps);
+    rate_scale = (gap > 0.0 ? law.G() / (c * law.eta_0()) : 0.0) + K0 * (gdp * (1.0 + x * std::sqrt(x)) + tau * inv_eta_B + s.xi_dot_eps);
   }
 };
 
@@ -182,19 +182,33 @@ struct ReducedRhs {
 
 void reduced_relax_ode(const GranularLaw& law, double phi, double span, double& tau, double& f) {
   ReducedRhs rhs{law, phi, rheology::f_m(law.steady(), phi), rheology::inverse_eta_B(law.steady(), phi)};
+  const double f_top = rheology::f_upper(law.steady(), phi);
   double t = 0.0;
-  int guard = 0;
+  long guard = 0;
   while (t < span && guard++ < 10000000) {
     double k1t, k1f, rate;
     rhs(tau, f, k1t, k1f, rate);
-    const double h = std::min(span - t, 0.05 / std::max(rate, 1e-300));
-    double k2t, k2f, k3t, k3f, k4t, k4f, dummy;
-    rhs(tau + 0.5 * h * k1t, f + 0.5 * h * k1f, k2t, k2f, dummy);
-    rhs(tau + 0.5 * h * k2t, f + 0.5 * h * k2f, k3t, k3f, dummy);
-    rhs(tau + h * k3t, f + h * k3f, k4t, k4f, dummy);
-    tau += h / 6.0 * (k1t + 2.0 * k2t + 2.0 * k3t + k4t);
-    f += h / 6.0 * (k1f + 2.0 * k2f + 2.0 * k3f + k4f);
-    t += h;
+    double h = std::min(span - t, 0.05 / std::max(rate, 1e-300));
+    // RK4 step; retried with a smaller step if it leaves the admissible set (tau >= 0, 0 <= f < f_u)
+    // or changes tau by more than 20% (c(f) is very steep near f_u).
+    for (int retry = 0;; ++retry) {
+      double k2t, k2f, k3t, k3f, k4t, k4f, dummy;
+      rhs(tau + 0.5 * h * k1t, f + 0.5 * h * k1f, k2t, k2f, dummy);
+      rhs(tau + 0.5 * h * k2t, f + 0.5 * h * k2f, k3t, k3f, dummy);
+      rhs(tau + h * k3t, f + h * k3f, k4t, k4f, dummy);
+      const double tn = tau + h / 6.0 * (k1t + 2.0 * k2t + 2.0 * k3t + k4t);
+      const double fn = f + h / 6.0 * (k1f + 2.0 * k2f + 2.0 * k3f + k4f);
+      const bool good = std::isfinite(tn) && std::isfinite(fn) && tn >= 0.0 && fn >= 0.0 && fn < f_top &&
+                        std::fabs(tn - tau) <= 0.2 * tau;
+      if (good || retry >= 60) {
+        tau = tn;
+        f = fn;
+        t += h;
+        break;
+      }
+      h *= 0.25;
+    }
+    if (!std::isfinite(tau) || !std::isfinite(f)) break;
   }
   if (!std::isfinite(tau) || !std::isfinite(f)) {
     throw NumericalError(fmt::format("reduced relaxation ODE: non-finite state (tau_bar = {}, f = {}) at phi = {}",
@@ -232,31 +246,43 @@ RelaxResult run_relax(const GranularLaw& law, const RelaxOptions& o, const Progr
   // steps of at most 2% strain that also resolve the structure rate K_0 gamma_dot (1 + H) of E24
   auto pre_dt = [&](double tau_est) {
     const double x = tau_est / law.steady().tau_star;
-    return std::min(0.02, 0.1 / (law.granular().K_0 * (1.0 + x * std::sqrt(x)))) / rate_est;
+    return std::max(std::min(0.02, 0.1 / (law.granular().K_0 * (1.0 + x * std::sqrt(x)))), 1e-5) / rate_est;
   };
   double dt_pre = o.stress_controlled ? pre_dt(o.shear_stress) : 0.02 / rate_est;
   GranularUpdate u;
-  double prev_tau = -1.0, prev_f = -1.0;
-  int quiet = 0;
+  // Stationarity over windows of max(50 steps, 0.05 strain): relative change of tau_bar <= 1e-8 and
+  // of f <= 1e-9 and of gamma_dot^p <= 1e-7 across two consecutive windows (robust to step-to-step round-off jitter).
+  double win_tau = -1.0, win_f = -1.0, win_g = -1.0;
+  int still_windows = 0;
   long k = 0;
-  const long k_max = 2000000;
+  const long k_max = 4000000;
+  bool steady = false;
   for (; k < k_max; ++k) {
     if (o.stress_controlled) {
       stress_controlled_step(law, st, o.phi, dt_pre, o.shear_stress, u);
     } else {
       u = checked_update(law, st, D, W, dt_pre, o.phi);
     }
-    const bool still = std::fabs(u.tau_bar - prev_tau) <= 1e-11 * u.tau_bar && std::fabs(st.f - prev_f) <= 1e-12;
-    quiet = still ? quiet + 1 : 0;
-    prev_tau = u.tau_bar;
-    prev_f = st.f;
     if (!o.stress_controlled && k == 200) dt_pre = std::min(dt_pre, pre_dt(u.tau_bar));
-    if (quiet >= 50 && k > 500) break;
+    const long window = std::max(50L, static_cast<long>(std::ceil(0.05 / (rate_est * dt_pre))));
+    if (k > 200 && k % window == 0) {
+      const bool still = std::fabs(u.tau_bar - win_tau) <= 1e-8 * u.tau_bar && std::fabs(st.f - win_f) <= 1e-9 &&
+                         std::fabs(u.gamma_dot_p - win_g) <= 1e-7 * u.gamma_dot_p;
+      win_g = u.gamma_dot_p;
+      still_windows = still ? still_windows + 1 : 0;
+      win_tau = u.tau_bar;
+      win_f = st.f;
+      if (still_windows >= 2) {
+        steady = true;
+        break;
+      }
+    }
   }
-  if (k >= k_max) {
+  if (!steady) {
     throw NumericalError(fmt::format("point relax: pre-shear (rate {} 1/s) did not reach a steady state within {} "
-                                     "strain (tau_bar = {} Pa, f = {})",
-                                     rate_est, 0.02 * static_cast<double>(k_max), u.tau_bar, st.f));
+                                     "strain (tau_bar = {} Pa, f = {}); at tau_bar comparable to G = {} Pa the "
+                                     "hypo-elastic rotation relaxes slowly",
+                                     rate_est, rate_est * dt_pre * static_cast<double>(k), u.tau_bar, st.f, law.G()));
   }
   if (u.tau_bar <= 0.0 || u.regime == GranularRegime::kSeparated) {
     throw NumericalError(fmt::format("point relax: the pre-sheared state carries no granular stress (regime {}, "
@@ -271,6 +297,11 @@ RelaxResult run_relax(const GranularLaw& law, const RelaxOptions& o, const Progr
     const double gap = rheology::phi_m_gap(s, rheology::f_jam(s, o.phi) - st.f);
     const double c = rheology::granular_viscosity(o.phi, rheology::a_of_f(s, st.f), gap, s.mu_c);
     r.relaxation_time_0 = c * law.eta_0() / law.G();
+    if (!(gap > 0.0) || !std::isfinite(r.relaxation_time_0)) {
+      throw NumericalError(fmt::format("point relax: the pre-sheared state is shear-jammed (f = {} reached f_jam, "
+                                       "phi_m(f) = phi): no viscous relaxation; lower the pre-shear stress",
+                                       st.f));
+    }
   }
   // ---- relaxation: D = W = 0 ----
   const double dt0 = o.dt > 0.0 ? o.dt : r.relaxation_time_0 / 20.0;
