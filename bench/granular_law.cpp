@@ -89,18 +89,20 @@ void run(benchmark::State& bs, const std::vector<Case>& cases) {
   const material::GranularLaw& L = law();
   const double dt = 1e-6;
   std::size_t i = 0;
-  long failures = 0;
+  long failures = 0, implicit = 0;
   for (auto _ : bs) {
     const Case& c = cases[i];
     material::GranularState s = c.state;
     const material::GranularUpdate u = L.update(s, c.D, c.W, dt, c.phi);
     failures += u.ok() ? 0 : 1;
+    implicit += u.structure_iterations > 0 ? 1 : 0;
     benchmark::DoNotOptimize(s);
     benchmark::DoNotOptimize(u.iterations);
     if (++i == cases.size()) i = 0;
   }
   bs.SetItemsProcessed(bs.iterations());
   bs.counters["failures"] = static_cast<double>(failures);
+  bs.counters["implicit_f"] = static_cast<double>(implicit) / static_cast<double>(bs.iterations());
 }
 
 void BM_GranularUpdateMix(benchmark::State& bs) {

@@ -58,7 +58,7 @@ void sweep(const std::string& preset_name, int n, std::uint64_t seed, double K_0
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> U(0.0, 1.0);
   int counts[5] = {0, 0, 0, 0, 0};
-  int failures = 0;
+  int failures = 0, implicit = 0;
   for (int k = 0; k < n; ++k) {
     const double phi = 0.3 + 0.3 * U(rng);
     material::GranularState st;
@@ -83,6 +83,7 @@ void sweep(const std::string& preset_name, int n, std::uint64_t seed, double K_0
     const material::GranularState before = st;
     const material::GranularUpdate u = law.update(st, D, W, dt, phi);
     counts[static_cast<int>(u.regime)]++;
+    implicit += u.structure_iterations > 0 ? 1 : 0;
     bool ok = true;
     auto fail = [&](const char* what) {
       if (failures < 10) ADD_FAILURE() << what << ": " << law.describe(u, before, D, W, dt, phi);
@@ -97,8 +98,11 @@ void sweep(const std::string& preset_name, int n, std::uint64_t seed, double K_0
     const double scale = std::max({u.tau_trial, std::fabs(u.p_trial), 1e-300});
     if (std::fabs(material::pressure(st.sigma) - u.p) > 1e-10 * scale) fail("p(sigma) != p");
     if (std::fabs(material::tau_bar(st.sigma) - u.tau_bar) > 1e-10 * scale) fail("tau_bar(sigma) != tau_bar");
-    const double fo = before.f;
-    const double phim = P.steady.phi_j + (P.steady.phi_c - P.steady.phi_j) * fo;  // E1
+    // structure used by the return map: f_n (staggered) or f_{n+1} (implicit update), recovered from phi_m
+    const double fo = (P.steady.phi_j - u.phi_m) / (P.steady.phi_j - P.steady.phi_c);
+    if (u.structure_iterations == 0 && std::fabs(fo - before.f) > 1e-12) fail("staggered update with phi_m != phi_m(f_n)");
+    if (u.structure_iterations > 0 && std::fabs(fo - st.f) > 1e-9) fail("implicit update: phi_m != phi_m(f_{n+1})");
+    const double phim = u.phi_m;  // E1
     const double a = P.steady.a_0 + (P.steady.a_inf - P.steady.a_0) * fo;       // E2
     const double Gdt = P.granular.G * dt, Kdt = P.granular.K * dt;
     switch (u.regime) {
@@ -153,8 +157,9 @@ void sweep(const std::string& preset_name, int n, std::uint64_t seed, double K_0
   EXPECT_GT(counts[1], n / 1000);
   EXPECT_GT(counts[2], n / 1000);
   EXPECT_GT(counts[3], n / 1000);
-  std::printf("%s: elastic %d separated %d shear %d shear+compaction %d compaction %d\n", preset_name.c_str(),
-              counts[0], counts[1], counts[2], counts[3], counts[4]);
+  EXPECT_GT(implicit, n / 100);  // the implicit structure update is exercised too
+  std::printf("%s: elastic %d separated %d shear %d shear+compaction %d compaction %d (implicit f: %d)\n",
+              preset_name.c_str(), counts[0], counts[1], counts[2], counts[3], counts[4], implicit);
 }
 
 }  // namespace

@@ -78,42 +78,17 @@ inline bool finite3(const Eigen::Matrix3d& m) { return m.allFinite(); }
 
 }  // namespace
 
-GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
-                                   double dt, double phi, double eta_0) const {
-  GranularUpdate out;
-  out.f_old = state.f;
-  // ---- input checks (never throw in the hot loop; report instead) ----
-  if (!(dt > 0.0 && std::isfinite(dt)) || !(phi > 0.0 && phi < 1.0) || !(eta_0 > 0.0 && std::isfinite(eta_0)) ||
-      !(state.f >= 0.0 && state.f <= 1.0) || !finite3(state.sigma) || !finite3(D) || !finite3(W)) {
-    out.finite = false;
-    out.converged = false;
-    out.message = "invalid input: need dt > 0, 0 < phi < 1, eta_0 > 0, f in [0, 1] and finite sigma, D, W";
-    return out;
-  }
-  const double fn = state.f;
+GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_0, double dt, double p_tr,
+                                               double tau_tr) const {
   const double tol = options_.rel_tol;
   const int cap = options_.max_iter;
-  out.jammed = phi >= phi_j_;
-
-  // ---- E1, E2 with the structure at the start of the step (staggered f, docs/granular.md) ----
-  const double phi_m = phi_j_ + (phi_c_ - phi_j_) * fn;  // E1
-  const double a = a_0_ + (a_inf_ - a_0_) * fn;          // E2
-  out.phi_m = phi_m;
+  // ---- E1, E2 with the structure used by this return map (f_n when staggered) ----
+  const double phi_m = phi_j_ + (phi_c_ - phi_j_) * f;  // E1
+  const double a = a_0_ + (a_inf_ - a_0_) * f;          // E2
   const double Gdt = G_ * dt;
   const double Kdt = K_ * dt;
   const double visc = 2.5 * phi / a * eta_0;  // E20 viscous friction times p: visc * gamma_dot/I_m
   const double two_eta = 2.0 * eta_0;
-
-  // ---- E16: elastic trial (D^p = 0), explicit Jaumann rotation with sigma_n ----
-  const double trD = D.trace();
-  Eigen::Matrix3d sig_tr = state.sigma + dt * (2.0 * G_ * D + W * state.sigma - state.sigma * W);
-  sig_tr.diagonal().array() += dt * (K_ - 2.0 * G_ / 3.0) * trD;
-  const double p_tr = -sig_tr.trace() / 3.0;
-  Eigen::Matrix3d s_tr = sig_tr;
-  s_tr.diagonal().array() += p_tr;  // dev sigma_tr
-  const double tau_tr = std::sqrt(0.5 * s_tr.squaredNorm());
-  out.tau_trial = tau_tr;
-  out.p_trial = p_tr;
 
   // E18 dilation as a function of I_m (u) and its derivative.
   auto beta_of = [&](double u) { return K_3_ * (phi - phi_m / (1.0 + a * u)); };
@@ -355,11 +330,148 @@ GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& 
     }
   }
 
+  ReturnMap r;
+  r.tau = tau;
+  r.p = p;
+  r.g = g;
+  r.xi1 = xi1;
+  r.xi2 = xi2;
+  r.residual = residual;
+  r.regime = regime;
+  r.converged = converged;
+  r.iterations = iterations;
+  (void)u;
+  return r;
+}
+
+GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
+                                   double dt, double phi, double eta_0) const {
+  GranularUpdate out;
+  out.f_old = state.f;
+  // ---- input checks (never throw in the hot loop; report instead) ----
+  if (!(dt > 0.0 && std::isfinite(dt)) || !(phi > 0.0 && phi < 1.0) || !(eta_0 > 0.0 && std::isfinite(eta_0)) ||
+      !(state.f >= 0.0 && state.f <= 1.0) || !finite3(state.sigma) || !finite3(D) || !finite3(W)) {
+    out.finite = false;
+    out.converged = false;
+    out.message = "invalid input: need dt > 0, 0 < phi < 1, eta_0 > 0, f in [0, 1] and finite sigma, D, W";
+    return out;
+  }
+  const double fn = state.f;
+  out.jammed = phi >= phi_j_;
+
+  // ---- E16: elastic trial (D^p = 0), explicit Jaumann rotation with sigma_n ----
+  const double trD = D.trace();
+  Eigen::Matrix3d sig_tr = state.sigma + dt * (2.0 * G_ * D + W * state.sigma - state.sigma * W);
+  sig_tr.diagonal().array() += dt * (K_ - 2.0 * G_ / 3.0) * trD;
+  const double p_tr = -sig_tr.trace() / 3.0;
+  Eigen::Matrix3d s_tr = sig_tr;
+  s_tr.diagonal().array() += p_tr;  // dev sigma_tr
+  const double tau_tr = std::sqrt(0.5 * s_tr.squaredNorm());
+  out.tau_trial = tau_tr;
+  out.p_trial = p_tr;
+
+  // ---- E24 ingredients that depend on phi only: f_m (E9), 1/eta_B (E8) ----
+  const double fm = rheology::f_m(steady_, phi);
+  double inv_eta_B = 0.0;
+  if (const double gap = phi_j_ - phi; gap > 0.0) {
+    double lg = 0.0;
+    bool have = false;
+    for (const rheology::EtaBTerm& t : steady_.eta_B_terms) inv_eta_B += t.phi_i * pow_term(gap, t.alpha, lg, have);
+  }
+  // Linearly implicit E24 step with end-of-step tau_bar, gamma_dot^p: f = (f_n + dt H' f_m)/(1 + dt (H' + S')),
+  // H' = K_0 gamma_dot^p (tau_bar/tau*)^{3/2}, S' = K_0 (gamma_dot^p + tau_bar/eta_B + xi_dot_eps); `stiff` = dt (H' + S').
+  auto f_next = [&](const ReturnMap& r, double& stiff) {
+    const double x = r.tau / tau_star_;
+    const double Hp = K_0_ * r.g * x * std::sqrt(x);
+    const double Sp = K_0_ * (r.g + r.tau * inv_eta_B + xi_dot_eps_);
+    stiff = dt * (Hp + Sp);
+    return std::clamp((fn + dt * Hp * fm) / (1.0 + stiff), 0.0, 1.0);
+  };
+
+  // ---- return map with f_n, then the structure update ----
+  ReturnMap r = return_map(fn, phi, eta_0, dt, p_tr, tau_tr);
+  double stiff = 0.0;
+  double f_used = fn;
+  double f_new = f_next(r, stiff);
+  const bool forced = out.jammed && options_.jammed_structure == JammedStructure::kForceOne;
+  if (forced) {
+    f_new = 1.0;
+  } else if (options_.structure_update == StructureUpdate::kImplicit ||
+             (options_.structure_update == StructureUpdate::kAuto && stiff > options_.stiff_structure)) {
+    // Monolithic backward Euler in f: find f with f = f_next(return_map(f)), i.e. phi_m, a of the return
+    // map and the E24 rates all at the end of the step. Z(f) = f - f_next(return_map(f)) has Z(0) <= 0 and
+    // Z(max(f_n, f_m)) >= 0 (f_next <= max(f_n, f_m)); the bracket starts at [f_n, staggered f] so that
+    // the root nearest the staggered prediction is found; Illinois iteration.
+    ReturnMap rz;
+    double dummy = 0.0;
+    auto Z = [&](double ff, ReturnMap& rr, double& fnext) {
+      rr = return_map(ff, phi, eta_0, dt, p_tr, tau_tr);
+      fnext = f_next(rr, dummy);
+      out.structure_iterations++;
+      return ff - fnext;
+    };
+    double a_f = fn, Za = fn - f_new;  // Z(f_n) from the staggered solve
+    ReturnMap ra = r;
+    double fa_next = f_new;
+    double b_f = f_new, fb_next = 0.0;
+    ReturnMap rb;
+    double Zb = Z(b_f, rb, fb_next);
+    if (Za != 0.0 && (Zb > 0.0) == (Za > 0.0) && Zb != 0.0) {  // no sign change: widen to the safe end
+      b_f = f_new > fn ? std::max(fn, fm) : 0.0;
+      Zb = Z(b_f, rb, fb_next);
+    }
+    bool ok = true;
+    if (Za == 0.0) {
+      rz = ra;
+      f_used = a_f;
+      f_new = fa_next;
+    } else if (Zb == 0.0 || (Zb > 0.0) == (Za > 0.0)) {
+      rz = rb;  // Zb == 0, or (only by round-off) no bracket: take the end point
+      f_used = b_f;
+      f_new = fb_next;
+      ok = std::fabs(Zb) <= 1e-12;
+    } else {
+      int side = 0;
+      ok = false;
+      for (int k = 0; k < options_.max_iter; ++k) {
+        double fc = (Za - Zb) != 0.0 ? (a_f * Zb - b_f * Za) / (Zb - Za) : 0.5 * (a_f + b_f);
+        if (!(fc > std::min(a_f, b_f) && fc < std::max(a_f, b_f))) fc = 0.5 * (a_f + b_f);
+        double fc_next = 0.0;
+        const double Zc = Z(fc, rz, fc_next);
+        f_used = fc;
+        f_new = fc_next;
+        if (std::fabs(Zc) <= 1e-13 || std::fabs(b_f - a_f) <= 1e-14) {
+          ok = true;
+          break;
+        }
+        if ((Zc > 0.0) == (Za > 0.0)) {
+          a_f = fc;
+          Za = Zc;
+          if (side == 1) Zb *= 0.5;
+          side = 1;
+        } else {
+          b_f = fc;
+          Zb = Zc;
+          if (side == -1) Za *= 0.5;
+          side = -1;
+        }
+      }
+    }
+    r = rz;
+    r.converged = r.converged && ok;
+    if (!ok) out.message = "implicit structure update did not converge within the iteration cap";
+  }
+  const double phi_m = phi_j_ + (phi_c_ - phi_j_) * f_used;  // E1 as used by the return map
+  const double a = a_0_ + (a_inf_ - a_0_) * f_used;          // E2
+  out.phi_m = phi_m;
+  const double tau = r.tau, p = r.p, g = r.g;
+  const GranularRegime regime = r.regime;
+
   // ---- diagnostics E18–E20 at the end state ----
   out.regime = regime;
   out.gamma_dot_p = g;
-  out.xi_dot_1 = xi1;
-  out.xi_dot_2 = xi2;
+  out.xi_dot_1 = r.xi1;
+  out.xi_dot_2 = r.xi2;
   if (p > 0.0 && g > 0.0) {
     out.I_v = eta_0 * g / p;                      // E19
     out.I = g * granular_.d * std::sqrt(granular_.rho_s / p);
@@ -376,43 +488,22 @@ GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& 
     out.beta = g > 0.0 ? K_3_ * phi : K_3_ * (phi - phi_m);
     out.mu_p = mu_q(0.0);
   }
-  (void)u;
   out.tau_bar = tau;
   out.p = p;
-  out.iterations = iterations;
-  out.residual = residual;
-  out.converged = converged;
+  out.iterations = r.iterations;
+  out.residual = r.residual;
+  out.converged = r.converged;
 
   // ---- final stress: radial return in deviatoric space ----
   Eigen::Matrix3d sig = (tau_tr > 0.0 ? tau / tau_tr : 0.0) * s_tr;
   sig.diagonal().array() -= p;
-
-  // ---- E24: linearly implicit f update with end-of-step tau_bar, gamma_dot^p (staggered) ----
-  double f_new;
-  if (out.jammed && options_.jammed_structure == JammedStructure::kForceOne) {
-    f_new = 1.0;
-  } else {
-    const double fm = rheology::f_m(steady_, phi);  // E9
-    double inv_eta_B = 0.0;                          // E8
-    const double gap = phi_j_ - phi;
-    if (gap > 0.0 && tau > 0.0) {
-      double lg = 0.0;
-      bool have = false;
-      for (const rheology::EtaBTerm& t : steady_.eta_B_terms) inv_eta_B += t.phi_i * pow_term(gap, t.alpha, lg, have);
-    }
-    const double x = tau / tau_star_;
-    const double Hp = K_0_ * g * x * std::sqrt(x);                  // K_0 gamma_dot^p (tau_bar/tau*)^{3/2}
-    const double Sp = K_0_ * (g + tau * inv_eta_B + xi_dot_eps_);  // K_0 (gamma_dot^p + tau_bar/eta_B + xi_dot_eps)
-    f_new = (fn + dt * Hp * fm) / (1.0 + dt * (Hp + Sp));
-    f_new = std::clamp(f_new, 0.0, 1.0);
-  }
 
   if (!finite3(sig) || !std::isfinite(f_new) || !std::isfinite(g) || !std::isfinite(p)) {
     out.finite = false;
     out.message = "non-finite result (state left unchanged)";
     return out;
   }
-  if (!out.converged) out.message = "return map did not converge within the iteration cap";
+  if (!out.converged && out.message == nullptr) out.message = "return map did not converge within the iteration cap";
   state.sigma = sig;
   state.f = f_new;
   return out;

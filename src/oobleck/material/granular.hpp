@@ -45,7 +45,8 @@ struct GranularUpdate {
   bool converged = true;   ///< every scalar solve met its tolerance within the iteration cap
   bool finite = true;      ///< inputs and outputs are finite (false => state left unchanged)
   bool jammed = false;     ///< phi >= phi_j (see GranularOptions::jammed_structure)
-  int iterations = 0;      ///< scalar-solver iterations used (sum over nested solves)
+  int iterations = 0;      ///< scalar-solver iterations of the (final) return map
+  int structure_iterations = 0;  ///< return maps evaluated by the implicit structure update (0: staggered)
   double tau_bar = 0.0;    ///< equivalent shear stress tau_bar [Pa]
   double p = 0.0;          ///< granular pressure p~ [Pa]
   double tau_trial = 0.0;  ///< tau_bar of the elastic trial [Pa]
@@ -56,7 +57,7 @@ struct GranularUpdate {
   double I_v = 0.0;          ///< viscous number (E19) [-]
   double I = 0.0;            ///< inertial number (E19) [-]
   double I_m = 0.0;          ///< mixed number (E19) [-]
-  double phi_m = 0.0;        ///< phi_m(f_n) used in the return map (E1) [-]
+  double phi_m = 0.0;        ///< phi_m(f) used in the return map (E1; f_n staggered, f_{n+1} implicit) [-]
   double phi_eq = 0.0;       ///< critical-state fraction (E18) [-]
   double beta = 0.0;         ///< dilation (E18) [-]
   double mu_p = 0.0;         ///< internal friction (E20) [-]
@@ -72,10 +73,19 @@ enum class JammedStructure : std::uint8_t {
   kForceOne,  ///< f is set to 1 (what the authors' code does)
 };
 
+/// How f_{n+1} (E24) is coupled to the return map.
+enum class StructureUpdate : std::uint8_t {
+  kStaggered,  ///< return map with f_n, then the linearly implicit E24 step (model.md §3)
+  kImplicit,   ///< monolithic backward Euler: the return map uses f_{n+1} (scalar solve in f)
+  kAuto,       ///< staggered unless dt (H' + S') > stiff_structure, then implicit (default)
+};
+
 struct GranularOptions {
   double rel_tol = 1e-12;  ///< relative tolerance of the scalar solves [-]
   int max_iter = 80;       ///< iteration cap per scalar solve
   JammedStructure jammed_structure = JammedStructure::kEvolve;
+  StructureUpdate structure_update = StructureUpdate::kAuto;
+  double stiff_structure = 0.5;  ///< kAuto threshold on dt (H' + S') [-] (staggering oscillates when >~ 1)
 };
 
 /// The law with its constants precomputed. Cheap to copy; thread-safe (update() is const).
@@ -115,6 +125,15 @@ class GranularLaw {
   double mu_q(double I_m) const;
 
  private:
+  struct ReturnMap {
+    double tau = 0.0, p = 0.0, g = 0.0, xi1 = 0.0, xi2 = 0.0, residual = 0.0;
+    GranularRegime regime = GranularRegime::kElastic;
+    bool converged = true;
+    int iterations = 0;
+  };
+  /// E17–E23 at structure f for a given trial (p_tr, tau_tr): allocation-free, never throws.
+  ReturnMap return_map(double f, double phi, double eta_0, double dt, double p_tr, double tau_tr) const;
+
   rheology::SteadyParams steady_;
   rheology::GranularParams granular_;
   GranularOptions options_;
