@@ -1,6 +1,300 @@
-// `oobleck point ...`: placeholder until the material-point driver lands.
+// `oobleck point ...`: the granular law (model.md §3, E16–E24) at one homogeneous material point:
+// simple shear at fixed volume (rate- or stress-controlled) and relaxation after cessation of steady
+// shear beside the SI's reduced ODE.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include <fmt/format.h>
+
 #include "cli_common.hpp"
+#include "oobleck/core/error.hpp"
+#include "oobleck/io/output_file.hpp"
+#include "oobleck/material/point_driver.hpp"
+#include "oobleck/rheology/flow_curve.hpp"
 
 namespace oobleck::cli {
-void add_point_commands(CLI::App&) {}
+namespace {
+
+/// Plot through tools/<script>, writing `png` atomically (temporary file renamed on success).
+void plot(const std::string& script, std::vector<std::string> args, const std::string& png) {
+  const std::string tmp = png + ".tmp.png";
+  args.push_back(tmp);
+  try {
+    run_tool(script, args);
+  } catch (...) {
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    throw;
+  }
+  std::filesystem::rename(tmp, png);
+}
+
+/// Material overrides shared by the point commands; NaN means "keep the parameter set's value".
+struct MaterialOverrides {
+  double G = NAN, K = NAN, K0 = NAN, d = NAN, rho_s = NAN, mu_2 = NAN, b = NAN, K_3 = NAN, eta_0 = NAN;
+  void add_to(CLI::App* cmd, bool with_G_K0 = true) {
+    if (with_G_K0) {
+      cmd->add_option("--G", G, "granular shear modulus [Pa] (E16)");
+      cmd->add_option("--K0", K0, "rate factor of the structure evolution [-] (E24)");
+    }
+    cmd->add_option("--K", K, "granular bulk modulus [Pa] (E16)");
+    cmd->add_option("--d", d, "grain diameter [m] (E19)");
+    cmd->add_option("--rho-s", rho_s, "grain density [kg/m^3] (E19)");
+    cmd->add_option("--mu2", mu_2, "inertial friction limit mu_2 >= mu_c [-] (E20)");
+    cmd->add_option("--b", b, "inertial friction scale b >= 0 [-] (E20)");
+    cmd->add_option("--K3", K_3, "dilatancy slope K_3 >= 0 [-] (E18)");
+    cmd->add_option("--eta0", eta_0, "fluid viscosity [Pa s]");
+  }
+  void apply(rheology::Preset& p) const {
+    auto positive = [](const char* opt, double v, const char* unit) {
+      if (!std::isnan(v) && !(std::isfinite(v) && v > 0.0))
+        throw InputError(fmt::format("{} = {}: must be a positive number [{}]", opt, v, unit));
+      return !std::isnan(v);
+    };
+    auto nonneg = [](const char* opt, double v) {
+      if (!std::isnan(v) && !(std::isfinite(v) && v >= 0.0))
+        throw InputError(fmt::format("{} = {}: must be a finite number >= 0", opt, v));
+      return !std::isnan(v);
+    };
+    if (positive("--G", G, "Pa")) p.granular.G = G;
+    if (positive("--K", K, "Pa")) p.granular.K = K;
+    if (positive("--K0", K0, "-")) p.granular.K_0 = K0;
+    if (positive("--d", d, "m")) p.granular.d = d;
+    if (positive("--rho-s", rho_s, "kg/m^3")) p.granular.rho_s = rho_s;
+    if (positive("--eta0", eta_0, "Pa s")) p.steady.eta_0 = eta_0;
+    if (nonneg("--b", b)) p.granular.b = b;
+    if (nonneg("--K3", K_3)) p.granular.K_3 = K_3;
+    if (!std::isnan(mu_2)) {
+      if (!(std::isfinite(mu_2) && mu_2 >= p.steady.mu_c))
+        throw InputError(fmt::format("--mu2 = {}: must be >= mu_c = {}", mu_2, p.steady.mu_c));
+      p.granular.mu_2 = mu_2;
+    }
+    rheology::validate(p, "command line");
+  }
+};
+
+void check_phi(double phi) {
+  if (!(std::isfinite(phi) && phi > 0.0 && phi < 1.0))
+    throw InputError(fmt::format("--phi = {}: must lie in (0, 1)", phi));
+}
+
+/// Progress line on stderr at most once per second.
+class ProgressPrinter {
+ public:
+  explicit ProgressPrinter(std::string what) : what_(std::move(what)), last_(clock::now()) {}
+  void operator()(double frac, const material::PointSample& s) {
+    const auto now = clock::now();
+    if (now - last_ < std::chrono::seconds(1)) return;
+    last_ = now;
+    fmt::print(stderr, "{}: {:5.1f}%  t = {:.4g} s, tau_bar = {:.4g} Pa, f = {:.4g}\n", what_, 100.0 * frac, s.time,
+               s.granular_shear_stress, s.f);
+    std::fflush(stderr);
+  }
+
+ private:
+  using clock = std::chrono::steady_clock;
+  std::string what_;
+  clock::time_point last_;
+};
+
+void shear_command(CLI::App& point) {
+  auto* cmd = point.add_subcommand("shear", "homogeneous simple shear at fixed volume (E16–E24), rate- or stress-controlled");
+  struct Opts {
+    ParamsOption params;
+    MaterialOverrides mat;
+    double phi = NAN, rate = NAN, stress = NAN, duration = NAN, dt = NAN, f0 = 0.0;
+    int samples = 1000;
+    std::string out, png;
+  };
+  auto o = std::make_shared<Opts>();
+  o->params.add_to(cmd);
+  o->mat.add_to(cmd);
+  cmd->add_option("--phi", o->phi, "granular volume fraction (fixed)")->required();
+  auto* r = cmd->add_option("--shear-rate", o->rate, "imposed shear rate [1/s]");
+  auto* s = cmd->add_option("--shear-stress", o->stress,
+                            "imposed mixture shear stress tau = tau_bar + eta_0 (1 + 5 phi/2) gamma_dot [Pa]");
+  r->excludes(s);
+  s->excludes(r);
+  cmd->add_option("--duration", o->duration, "simulated time [s]")->required();
+  cmd->add_option("--dt", o->dt, "time step [s] (default: resolves eta/G of the low-viscosity branch and 1e-3 strain)");
+  cmd->add_option("--f0", o->f0, "initial structure f in [0, 1]")->capture_default_str();
+  cmd->add_option("--samples", o->samples, "number of CSV rows (evenly spaced in time)")->capture_default_str();
+  cmd->add_option("--out", o->out, "output CSV file")->required();
+  cmd->add_option("--plot", o->png, "also plot stresses and f against strain to this PNG");
+  cmd->callback([o] {
+    rheology::Preset p = o->params.load();
+    o->mat.apply(p);
+    check_phi(o->phi);
+    const bool by_stress = !std::isnan(o->stress);
+    if (std::isnan(o->rate) && !by_stress) throw InputError("one of --shear-rate R or --shear-stress S is required");
+    if (!by_stress && !(std::isfinite(o->rate) && o->rate > 0.0))
+      throw InputError(fmt::format("--shear-rate = {}: must be positive [1/s]", o->rate));
+    if (by_stress && !(std::isfinite(o->stress) && o->stress > 0.0))
+      throw InputError(fmt::format("--shear-stress = {}: must be positive [Pa]", o->stress));
+    if (!(std::isfinite(o->duration) && o->duration > 0.0))
+      throw InputError(fmt::format("--duration = {}: must be positive [s]", o->duration));
+    if (!std::isnan(o->dt) && !(std::isfinite(o->dt) && o->dt > 0.0 && o->dt <= o->duration))
+      throw InputError(fmt::format("--dt = {}: must lie in (0, --duration = {}] [s]", o->dt, o->duration));
+    if (!(o->f0 >= 0.0 && o->f0 <= 1.0)) throw InputError(fmt::format("--f0 = {}: must lie in [0, 1]", o->f0));
+    if (o->samples < 2) throw InputError(fmt::format("--samples = {}: must be >= 2", o->samples));
+    io::check_writable(o->out, "--out");
+    if (!o->png.empty()) io::check_writable(o->png, "--plot");
+
+    const material::GranularLaw law(p);
+    material::ShearOptions so;
+    so.phi = o->phi;
+    so.stress_controlled = by_stress;
+    so.shear_rate = by_stress ? 0.0 : o->rate;
+    so.shear_stress = by_stress ? o->stress : 0.0;
+    so.duration = o->duration;
+    so.dt = std::isnan(o->dt) ? 0.0 : o->dt;
+    so.f0 = o->f0;
+    so.samples = o->samples;
+    if (so.dt <= 0.0) {
+      const double rate_scale =
+          by_stress ? o->stress / (p.steady.eta_0 * rheology::eta_r_low(p.steady, std::min(o->phi, 0.999 * p.steady.phi_j)))
+                    : o->rate;
+      so.dt = material::default_dt(law, o->phi, rate_scale, o->duration);
+      fmt::print("dt = {:.4g} s (default{})\n", so.dt,
+                 so.dt <= o->duration / 2e7 * (1.0 + 1e-12) ? "; floored at duration/2e7: eta/G is not resolved" : "");
+    }
+    ProgressPrinter progress("point shear");
+    const auto res = material::run_shear(law, so, std::ref(progress));
+
+    io::OutputFile csv(o->out, "--out");
+    auto& st = csv.stream();
+    st << "time,strain,shear_rate,shear_stress,granular_shear_stress,granular_pressure,sigma_xy,f,phi,regime,"
+          "gamma_dot_p,I_v,I_m,beta,mu_p,phi_eq,iterations\n";
+    for (const auto& x : res.samples) {
+      st << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", num(x.time), num(x.strain),
+                        num(x.shear_rate), num(x.shear_stress), num(x.granular_shear_stress), num(x.granular_pressure),
+                        num(x.sigma_xy), num(x.f), num(x.phi), material::regime_name(x.regime), num(x.gamma_dot_p),
+                        num(x.I_v), num(x.I_m), num(x.beta), num(x.mu_p), num(x.phi_eq), x.iterations);
+    }
+    csv.commit();
+    const auto& last = res.samples.back();
+    fmt::print("wrote {} ({} steps of {:.4g} s; final: shear rate {:.6g} 1/s, tau {:.6g} Pa, tau_bar {:.6g} Pa, "
+               "p {:.6g} Pa, f {:.6g}, regime {})\n",
+               o->out, res.steps, res.dt, last.shear_rate, last.shear_stress, last.granular_shear_stress,
+               last.granular_pressure, last.f, material::regime_name(last.regime));
+    if (!o->png.empty()) {
+      const std::string title = fmt::format("{}, phi = {}, {}", p.name, o->phi,
+                                            by_stress ? fmt::format("tau = {} Pa", o->stress)
+                                                      : fmt::format("shear rate = {} 1/s", o->rate));
+      plot("plot_point_shear.py", {o->out, "--title", title}, o->png);
+      fmt::print("wrote {}\n", o->png);
+    }
+  });
+}
+
+void relax_command(CLI::App& point) {
+  auto* cmd = point.add_subcommand(
+      "relax", "stress relaxation after cessation of steady shear (SI: determining G and K_0), with the reduced ODE");
+  struct Opts {
+    ParamsOption params;
+    MaterialOverrides mat;
+    std::vector<double> G, K0;
+    double phi = NAN, rate = NAN, stress = NAN, duration = NAN, dt = NAN;
+    int samples = 200;
+    std::string out, png;
+  };
+  auto o = std::make_shared<Opts>();
+  o->params.add_to(cmd);
+  o->mat.add_to(cmd, false);
+  cmd->add_option("--G", o->G, "granular shear modulus/moduli [Pa] (repeat for several; default: parameter set)");
+  cmd->add_option("--K0", o->K0, "structure rate factor(s) [-] (repeat for several; default: parameter set)");
+  cmd->add_option("--phi", o->phi, "granular volume fraction (fixed)")->required();
+  auto* r = cmd->add_option("--shear-rate", o->rate, "pre-shear rate [1/s]");
+  auto* s = cmd->add_option("--shear-stress", o->stress, "pre-shear mixture shear stress [Pa] (stress-controlled)");
+  r->excludes(s);
+  s->excludes(r);
+  cmd->add_option("--duration", o->duration, "relaxation time after cessation [s]")->required();
+  cmd->add_option("--dt", o->dt, "first relaxation step [s] (default: 1/20 of c(f_0) eta_0/G); later dt = max(dt, t/50)");
+  cmd->add_option("--samples", o->samples, "CSV rows per case (log-spaced in time)")->capture_default_str();
+  cmd->add_option("--out", o->out, "output CSV file")->required();
+  cmd->add_option("--plot", o->png, "also plot tau_bar(t)/tau_bar_0 and f(t) with the reduced ODE to this PNG");
+  cmd->callback([o] {
+    rheology::Preset base = o->params.load();
+    o->mat.apply(base);
+    check_phi(o->phi);
+    rheology::validate_phi(base.steady, o->phi, "--phi");
+    const bool by_stress = !std::isnan(o->stress);
+    if (std::isnan(o->rate) && !by_stress) throw InputError("one of --shear-rate R or --shear-stress S is required");
+    if (!by_stress && !(std::isfinite(o->rate) && o->rate > 0.0))
+      throw InputError(fmt::format("--shear-rate = {}: must be positive [1/s]", o->rate));
+    if (by_stress && !(std::isfinite(o->stress) && o->stress > 0.0))
+      throw InputError(fmt::format("--shear-stress = {}: must be positive [Pa]", o->stress));
+    if (!(std::isfinite(o->duration) && o->duration > 0.0))
+      throw InputError(fmt::format("--duration = {}: must be positive [s]", o->duration));
+    if (!std::isnan(o->dt) && !(std::isfinite(o->dt) && o->dt > 0.0 && o->dt <= o->duration))
+      throw InputError(fmt::format("--dt = {}: must lie in (0, --duration = {}] [s]", o->dt, o->duration));
+    if (o->samples < 2) throw InputError(fmt::format("--samples = {}: must be >= 2", o->samples));
+    for (double g : o->G)
+      if (!(std::isfinite(g) && g > 0.0)) throw InputError(fmt::format("--G = {}: must be positive [Pa]", g));
+    for (double k : o->K0)
+      if (!(std::isfinite(k) && k > 0.0)) throw InputError(fmt::format("--K0 = {}: must be positive", k));
+    if (by_stress) (void)material::steady_rate_at_stress(base.steady, o->phi, o->stress);  // range check
+    io::check_writable(o->out, "--out");
+    if (!o->png.empty()) io::check_writable(o->png, "--plot");
+    std::vector<double> Gs = o->G.empty() ? std::vector<double>{base.granular.G} : o->G;
+    std::vector<double> K0s = o->K0.empty() ? std::vector<double>{base.granular.K_0} : o->K0;
+
+    std::vector<material::RelaxResult> results;
+    for (double K0 : K0s) {
+      for (double G : Gs) {
+        rheology::Preset p = base;
+        p.granular.G = G;
+        p.granular.K_0 = K0;
+        const material::GranularLaw law(p);
+        material::RelaxOptions ro;
+        ro.phi = o->phi;
+        ro.stress_controlled = by_stress;
+        ro.shear_rate = by_stress ? 0.0 : o->rate;
+        ro.shear_stress = by_stress ? o->stress : 0.0;
+        ro.duration = o->duration;
+        ro.dt = std::isnan(o->dt) ? 0.0 : o->dt;
+        ro.samples = o->samples;
+        ProgressPrinter progress(fmt::format("point relax G = {:g} Pa, K_0 = {:g}", G, K0));
+        results.push_back(material::run_relax(law, ro, std::ref(progress)));
+        const auto& rr = results.back();
+        fmt::print("G = {:g} Pa, K_0 = {:g}: steady tau_bar_0 = {:.6g} Pa, p_0 = {:.6g} Pa, f_0 = {:.6g} after {:.4g} "
+                   "strain; initial relaxation time c(f_0) eta_0/G = {:.4g} s; tau_bar(end)/tau_bar_0 = {:.4g}\n",
+                   G, K0, rr.tau_bar_0, rr.p_0, rr.f_0, rr.preshear_strain, rr.relaxation_time_0,
+                   rr.samples.back().tau_bar / rr.tau_bar_0);
+      }
+    }
+    io::OutputFile csv(o->out, "--out");
+    auto& st = csv.stream();
+    st << "case,G,K_0,time,granular_shear_stress,granular_pressure,f,gamma_dot_p,regime,ode_granular_shear_stress,ode_f\n";
+    for (std::size_t c = 0; c < results.size(); ++c) {
+      for (const auto& x : results[c].samples) {
+        st << fmt::format("{},{},{},{},{},{},{},{},{},{},{}\n", c, num(results[c].G), num(results[c].K_0), num(x.time),
+                          num(x.tau_bar), num(x.p), num(x.f), num(x.gamma_dot_p), material::regime_name(x.regime),
+                          num(x.ode_tau_bar), num(x.ode_f));
+      }
+    }
+    csv.commit();
+    fmt::print("wrote {} ({} cases)\n", o->out, results.size());
+    if (!o->png.empty()) {
+      const std::string title = fmt::format("{}, phi = {}, pre-shear {}", base.name, o->phi,
+                                            by_stress ? fmt::format("tau = {} Pa", o->stress)
+                                                      : fmt::format("{} 1/s", o->rate));
+      plot("plot_point_relax.py", {o->out, "--title", title}, o->png);
+      fmt::print("wrote {}\n", o->png);
+    }
+  });
+}
+
+}  // namespace
+
+void add_point_commands(CLI::App& app) {
+  auto* point = app.add_subcommand("point", "the granular law at one homogeneous material point (E16–E24)");
+  point->require_subcommand(1);
+  shear_command(*point);
+  relax_command(*point);
+}
+
 }  // namespace oobleck::cli

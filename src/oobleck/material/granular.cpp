@@ -1,0 +1,533 @@
+#include "oobleck/material/granular.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "oobleck/core/error.hpp"
+#include "oobleck/rheology/f_max.hpp"
+
+namespace oobleck::material {
+
+const char* regime_name(GranularRegime r) {
+  switch (r) {
+    case GranularRegime::kElastic: return "elastic";
+    case GranularRegime::kSeparated: return "separated";
+    case GranularRegime::kShear: return "shear";
+    case GranularRegime::kShearCompaction: return "shear+compaction";
+    case GranularRegime::kCompaction: return "compaction";
+  }
+  return "unknown";
+}
+
+GranularLaw::GranularLaw(const rheology::Preset& preset, GranularOptions options)
+    : steady_(preset.steady), granular_(preset.granular), options_(options) {
+  if (granular_.K_4 != 0.0) {
+    throw InputError(fmt::format(
+        "{}: key 'granular.K_4' = {}: the granular return map supports only K_4 = 0 (the value of every "
+        "paper preset; see docs/granular.md)",
+        preset.file.empty() ? preset.name : preset.file, granular_.K_4));
+  }
+  if (!(options_.rel_tol > 0.0 && options_.rel_tol < 1e-3) || options_.max_iter < 5) {
+    throw InputError(fmt::format("granular law options: rel_tol = {} must lie in (0, 1e-3) and max_iter = {} >= 5",
+                                 options_.rel_tol, options_.max_iter));
+  }
+  eta_0_ = steady_.eta_0;
+  G_ = granular_.G;
+  K_ = granular_.K;
+  mu_1_ = steady_.mu_c;
+  mu_2_ = granular_.mu_2 < 0.0 ? steady_.mu_c : granular_.mu_2;  // mu_2 < 0 means mu_2 = mu_c
+  b_ = granular_.b;
+  K_3_ = granular_.K_3;
+  K_0_ = granular_.K_0;
+  d2_rho_s_ = granular_.d * granular_.d * granular_.rho_s;
+  tau_star_ = steady_.tau_star;
+  xi_dot_eps_ = steady_.xi_dot_eps;
+  phi_c_ = steady_.phi_c;
+  phi_j_ = steady_.phi_j;
+  a_0_ = steady_.a_0;
+  a_inf_ = steady_.a_inf;
+}
+
+double GranularLaw::mu_q(double I_m) const {
+  // E20 without the viscous term: mu_1 + (mu_2 - mu_1)/(1 + b/I_m) = mu_1 + (mu_2 - mu_1) I_m/(I_m + b).
+  if (b_ == 0.0) return mu_2_;  // limit I_m -> 0+ as well
+  return mu_1_ + (mu_2_ - mu_1_) * I_m / (I_m + b_);
+}
+
+namespace {
+
+/// x^alpha for alpha >= 0, with small integer exponents by multiplication (E8 is evaluated per call).
+inline double pow_term(double x, double alpha, double& log_x, bool& have_log) {
+  const double r = std::nearbyint(alpha);
+  if (r == alpha && r <= 8.0) {
+    double y = 1.0;
+    for (int k = 0; k < static_cast<int>(r); ++k) y *= x;
+    return y;
+  }
+  if (!have_log) {
+    log_x = std::log(x);
+    have_log = true;
+  }
+  return std::exp(alpha * log_x);
+}
+
+inline bool finite3(const Eigen::Matrix3d& m) { return m.allFinite(); }
+
+}  // namespace
+
+GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_0, double dt, double p_tr,
+                                               double tau_tr) const {
+  const double tol = options_.rel_tol;
+  const int cap = options_.max_iter;
+  // ---- E1, E2 with the structure used by this return map (f_n when staggered) ----
+  const double phi_m = phi_j_ + (phi_c_ - phi_j_) * f;  // E1
+  const double a = a_0_ + (a_inf_ - a_0_) * f;          // E2
+  const double Gdt = G_ * dt;
+  const double Kdt = K_ * dt;
+  const double visc = 2.5 * phi / a * eta_0;  // E20 viscous friction times p: visc * gamma_dot/I_m
+  const double two_eta = 2.0 * eta_0;
+
+  // E18 dilation as a function of I_m (u) and its derivative.
+  auto beta_of = [&](double u) { return K_3_ * (phi - phi_m / (1.0 + a * u)); };
+  auto dbeta_of = [&](double u) {
+    const double q = 1.0 + a * u;
+    return K_3_ * phi_m * a / (q * q);
+  };
+  // E19 I_m from (gamma_dot, p): I_m^2 = Q(gamma_dot)/p with Q = gamma_dot (gamma_dot d^2 rho_s + 2 eta_0).
+  auto Q_of = [&](double g) { return g * (g * d2_rho_s_ + two_eta); };
+  const double u_eq = phi < phi_m ? (phi_m - phi) / (a * phi) : 0.0;  // I_m at which beta = 0
+
+  double tau = 0.0, p = 0.0, g = 0.0, u = 0.0, xi1 = 0.0, xi2 = 0.0;
+  GranularRegime regime = GranularRegime::kElastic;
+  bool converged = true;
+  int iterations = 0;
+  double residual = 0.0;
+  const double g_max = tau_tr / Gdt;   // gamma_dot^p at which tau_bar = 0 (radial return)
+  const double dil = Kdt * K_3_ * phi;  // d p/d gamma_dot at p -> 0 (I_m -> infinity: beta -> K_3 phi)
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+
+  // Friction side of E21 at (gamma_dot, p, I_m): max((mu_p + beta) p, 0), with E20 written as
+  // mu_p p = mu_q(I_m) p + (5/2)(phi/a) eta_0 gamma_dot/I_m.
+  auto friction = [&](double gg, double pp, double uu) {
+    if (!(pp > 0.0)) return 0.0;
+    if (!(uu > 0.0)) return std::max((mu_q(0.0) + beta_of(0.0)) * pp, 0.0);
+    return std::max((mu_q(uu) + beta_of(uu)) * pp + visc * gg / uu, 0.0);
+  };
+
+  // ---- General shear solve in gamma_dot (used for p_tr <= 0 and as the fallback of the fast path).
+  // Inner: for fixed gamma_dot the pressure balance R_a(p) = p - p_tr - K dt gamma_dot beta(I_m(gamma_dot, p))
+  // is strictly increasing in p (beta decreases with p), root in (0, p_tr + K dt K_3 phi gamma_dot].
+  auto p_of = [&](double gg, double& uu, bool& ok) -> double {
+    ok = true;
+    if (!(gg > 0.0)) {
+      uu = 0.0;
+      return std::max(p_tr, 0.0);
+    }
+    if (p_tr + dil * gg <= 0.0) {  // no contact pressure even with full dilatancy
+      uu = kInf;
+      return 0.0;
+    }
+    const double Q = Q_of(gg), ck = Kdt * gg;
+    double plo = 0.0, phigh = p_tr + dil * gg, x = phigh;
+    ok = false;
+    for (int k = 1; k <= cap; ++k) {
+      ++iterations;
+      const double um = std::sqrt(Q / x);
+      const double Ra = x - p_tr - ck * beta_of(um);
+      if (std::fabs(Ra) <= 1e-15 * (x + std::fabs(p_tr))) {
+        ok = true;
+        break;
+      }
+      const double dRa = 1.0 + ck * dbeta_of(um) * um / (2.0 * x);
+      if (Ra > 0.0) phigh = x; else plo = x;
+      double nx = x - Ra / dRa;
+      const bool newton = nx > plo && nx < phigh;
+      if (!newton) nx = 0.5 * (plo + phigh);
+      if ((newton && std::fabs(nx - x) <= tol * x) || (phigh - plo) <= tol * phigh) {
+        x = nx;
+        ok = true;
+        break;
+      }
+      x = nx;
+    }
+    uu = std::sqrt(Q / x);
+    return x;
+  };
+  // Outer: R(gamma_dot) = tau_tr - G dt gamma_dot - friction, R(glo) > 0 >= R(ghi); Illinois.
+  auto solve_g = [&](double glo, double ghi) {
+    bool ok_in = true, all_ok = true;
+    double pp = 0.0, uu = 0.0;
+    auto R_g = [&](double gg) {
+      pp = p_of(gg, uu, ok_in);
+      all_ok = all_ok && ok_in;
+      return tau_tr - Gdt * gg - friction(gg, pp, uu);
+    };
+    double Rlo = R_g(glo), Rhi = R_g(ghi);
+    double gg = ghi, R = Rhi;
+    bool done = false;
+    int side = 0;
+    for (int k = 1; k <= cap && !done; ++k) {
+      ++iterations;
+      gg = (Rlo - Rhi) > 0.0 ? (glo * Rhi - ghi * Rlo) / (Rhi - Rlo) : 0.5 * (glo + ghi);
+      if (!(gg > glo && gg < ghi)) gg = 0.5 * (glo + ghi);
+      R = R_g(gg);
+      if (std::fabs(R) <= 1e-14 * tau_tr) break;
+      if (R > 0.0) {
+        glo = gg;
+        Rlo = R;
+        if (side == 1) Rhi *= 0.5;
+        side = 1;
+      } else {
+        ghi = gg;
+        Rhi = R;
+        if (side == -1) Rlo *= 0.5;
+        side = -1;
+      }
+      done = (ghi - glo) <= tol * ghi;
+    }
+    g = gg;
+    p = pp;
+    u = uu;
+    residual = std::fabs(R) / tau_tr;
+    converged = all_ok && residual <= 1e-9;
+  };
+
+  if (p_tr > 0.0) {
+    // -------- compressive trial: elastic, shear (f_1), or compaction (f_1 + f_3) --------
+    const double mu0 = mu_q(0.0);
+    const bool f3_trial_active = phi < phi_m;                                      // E23: g(phi) p_tr > 0
+    const double f1_trial = tau_tr - std::max((mu0 + beta_of(0.0)) * p_tr, 0.0);  // E21 at gamma_dot = 0
+    if (!f3_trial_active && f1_trial <= 0.0) {
+      regime = GranularRegime::kElastic;
+      tau = tau_tr;
+      p = p_tr;
+    } else {
+      // Fast path, parametrised by u = I_m >= u_eq (beta >= 0, xi_dot_2 = 0): for given u the
+      // pressure balance p = p_tr + K dt beta(u) gamma_dot with p = Q(gamma_dot)/u^2 is a quadratic
+      // in gamma_dot with one positive root; R(u) = tau_tr - G dt gamma_dot - (mu_p + beta) p is the
+      // E21 residual (decreasing in u, see docs/granular.md).
+      struct Eval {
+        double g, dg, p, dp, R, dR;
+      };
+      auto eval = [&](double uu) {
+        Eval e{};
+        const double be = beta_of(uu), dbe = dbeta_of(uu);
+        const double A2 = d2_rho_s_;
+        const double B2 = two_eta - Kdt * be * uu * uu;
+        const double C2 = p_tr * uu * uu;
+        const double disc = std::sqrt(B2 * B2 + 4.0 * A2 * C2);
+        e.g = B2 >= 0.0 ? 2.0 * C2 / (B2 + disc) : (disc - B2) / (2.0 * A2);
+        const double dB2 = -Kdt * (dbe * uu * uu + 2.0 * be * uu);
+        const double dC2 = 2.0 * p_tr * uu;
+        e.dg = disc > 0.0 ? (dC2 - dB2 * e.g) / disc : 0.0;
+        e.p = p_tr + Kdt * be * e.g;
+        e.dp = Kdt * (dbe * e.g + be * e.dg);
+        const double mq = mu_q(uu);
+        const double dmq = b_ == 0.0 ? 0.0 : (mu_2_ - mu_1_) * b_ / ((uu + b_) * (uu + b_));
+        // viscous friction term of E20 times p: (5/2) phi/a * I_v/I_m * p = visc * g/u
+        double gv = 0.0, dgv = 0.0;
+        if (uu > 0.0) {
+          gv = e.g / uu;
+          dgv = e.dg / uu - e.g / (uu * uu);
+        } else {
+          dgv = p_tr / two_eta;  // g ~ p_tr u^2/(2 eta_0) as u -> 0
+        }
+        e.R = tau_tr - Gdt * e.g - (mq + be) * e.p - visc * gv;
+        e.dR = -Gdt * e.dg - (dmq + dbe) * e.p - (mq + be) * e.dp - visc * dgv;
+        return e;
+      };
+      const Eval e_lo = eval(u_eq);
+      if (e_lo.R <= 0.0 && u_eq > 0.0) {
+        // -------- f_1 + f_3 (E21, E23 with K_4 = 0): beta = 0, I_m = u_eq; closed form ----------
+        // tau_tr - G dt g = mu_q p + visc g/u_eq with p = Q(g)/u_eq^2: quadratic A g^2 + B g - C = 0.
+        const double mq = mu_q(u_eq);
+        const double u2 = u_eq * u_eq;
+        const double A = mq * d2_rho_s_;
+        const double B = Gdt * u2 + mq * two_eta + visc * u_eq;
+        const double C = tau_tr * u2;
+        g = 2.0 * C / (B + std::sqrt(B * B + 4.0 * A * C));
+        p = std::min(Q_of(g) / u2, p_tr);  // <= p_tr by construction; min guards round-off
+        // tau_bar from the friction side of E21 (tau_tr - G dt g cancels when G dt g >> tau_bar)
+        tau = std::min(mq * p + visc * g / u_eq, tau_tr);
+        u = u_eq;
+        xi2 = std::min((p - p_tr) / Kdt, 0.0);  // E23: xi_dot_2 <= 0
+        regime = g > 0.0 ? GranularRegime::kShearCompaction : GranularRegime::kCompaction;
+      } else {
+        // -------- f_1 only: root of R(u) on [u_lo, u_hi] --------
+        double lo = u_eq, hi;
+        // Upper bracket: with beta >= 0, gamma_dot(u) >= the beta = 0 root, so gamma_dot(u_hi) >= gamma_max
+        // when Q(gamma_max)/u_hi^2 <= p_tr; there R <= -(mu_p + beta) p < 0.
+        hi = std::max(u_eq, std::sqrt(Q_of(g_max) / p_tr)) * (1.0 + 1e-12) + 1e-300;
+        // Initial guess: rigid-plastic, viscous balance tau_tr/p_tr = mu_q + beta(u) + (5/4)(phi/a) u
+        // (drop G dt, K dt): c1 a u^2 + (c1 - r a) u - (r + K_3 phi_m) = 0.
+        double x;
+        {
+          const double c1 = 1.25 * phi / a;
+          const double r = tau_tr / p_tr - mu0 - K_3_ * phi;
+          const double qa = c1 * a, qb = c1 - r * a, qc = -(r + K_3_ * phi_m);
+          const double disc = qb * qb - 4.0 * qa * qc;
+          x = (qc < 0.0 && disc >= 0.0) ? (qb <= 0.0 ? (-qb + std::sqrt(disc)) / (2.0 * qa)
+                                                      : -2.0 * qc / (qb + std::sqrt(disc)))
+                                        : 0.5 * (lo + hi);
+          if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
+          // Near a steady state the root sits just above u_eq: a Newton step from the lower end is better.
+          if (e_lo.dR < 0.0) {
+            const double xn = lo - e_lo.R / e_lo.dR;
+            if (xn > lo && xn < x) x = xn;
+          }
+        }
+        Eval e{};
+        converged = false;
+        for (iterations = 1; iterations <= cap; ++iterations) {
+          e = eval(x);
+          if (std::fabs(e.R) <= 1e-14 * tau_tr) {
+            converged = true;
+            break;
+          }
+          if (e.R > 0.0) lo = x; else hi = x;
+          double next = (e.dR < 0.0) ? x - e.R / e.dR : -1.0;
+          const bool newton = next > lo && next < hi;
+          if (!newton) next = (lo > 0.0 && hi > 4.0 * lo) ? std::sqrt(lo * hi) : 0.5 * (lo + hi);
+          if ((newton && std::fabs(next - x) <= tol * x) || (hi - lo) <= tol * hi) {
+            x = next;
+            e = eval(x);
+            converged = true;
+            break;
+          }
+          x = next;
+        }
+        residual = std::fabs(e.R) / tau_tr;
+        if (converged && residual <= 1e-10) {
+          u = x;
+          g = e.g;
+          p = e.p;
+        } else {
+          // u is ill-conditioned here (gamma_dot(u) steep where dilatancy dominates p_tr): solve in gamma_dot
+          solve_g(e_lo.g, g_max);
+        }
+        // tau_bar from the friction side of E21: accurate even when G dt g >> tau_bar
+        tau = std::min(friction(g, p, u), tau_tr);
+        regime = GranularRegime::kShear;
+      }
+    }
+  } else {
+    // -------- p_tr <= 0: separated (f_2 active) unless shear dilatancy builds pressure --------
+    if (!(tau_tr > 0.0) || !(p_tr + dil * g_max > 0.0)) {
+      regime = (tau_tr > 0.0 || p_tr < 0.0) ? GranularRegime::kSeparated : GranularRegime::kElastic;
+      g = tau_tr > 0.0 ? g_max : 0.0;
+      tau = 0.0;
+      p = 0.0;
+      xi1 = std::max(-p_tr / Kdt - K_3_ * phi * g, 0.0);  // E22: p = p_tr + K dt (beta g + xi_1) = 0
+    } else {
+      // flow with p > 0 created by dilatancy (rare path)
+      solve_g(std::max(-p_tr / dil, 0.0), g_max);
+      tau = std::min(friction(g, p, u), tau_tr);
+      regime = p > 0.0 ? GranularRegime::kShear : GranularRegime::kSeparated;
+      if (p <= 0.0) xi1 = std::max(-p_tr / Kdt - K_3_ * phi * g, 0.0);
+    }
+  }
+
+  ReturnMap r;
+  r.tau = tau;
+  r.p = p;
+  r.g = g;
+  r.xi1 = xi1;
+  r.xi2 = xi2;
+  r.residual = residual;
+  r.regime = regime;
+  r.converged = converged;
+  r.iterations = iterations;
+  (void)u;
+  return r;
+}
+
+GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
+                                   double dt, double phi, double eta_0) const {
+  GranularUpdate out;
+  out.f_old = state.f;
+  // ---- input checks (never throw in the hot loop; report instead) ----
+  if (!(dt > 0.0 && std::isfinite(dt)) || !(phi > 0.0 && phi < 1.0) || !(eta_0 > 0.0 && std::isfinite(eta_0)) ||
+      !(state.f >= 0.0 && state.f <= 1.0) || !finite3(state.sigma) || !finite3(D) || !finite3(W)) {
+    out.finite = false;
+    out.converged = false;
+    out.message = "invalid input: need dt > 0, 0 < phi < 1, eta_0 > 0, f in [0, 1] and finite sigma, D, W";
+    return out;
+  }
+  const double fn = state.f;
+  out.jammed = phi >= phi_j_;
+
+  // ---- E16: elastic trial (D^p = 0), explicit Jaumann rotation with sigma_n ----
+  const double trD = D.trace();
+  Eigen::Matrix3d sig_tr = state.sigma + dt * (2.0 * G_ * D + W * state.sigma - state.sigma * W);
+  sig_tr.diagonal().array() += dt * (K_ - 2.0 * G_ / 3.0) * trD;
+  const double p_tr = -sig_tr.trace() / 3.0;
+  Eigen::Matrix3d s_tr = sig_tr;
+  s_tr.diagonal().array() += p_tr;  // dev sigma_tr
+  const double tau_tr = std::sqrt(0.5 * s_tr.squaredNorm());
+  out.tau_trial = tau_tr;
+  out.p_trial = p_tr;
+
+  // ---- E24 ingredients that depend on phi only: f_m (E9), 1/eta_B (E8) ----
+  const double fm = rheology::f_m(steady_, phi);
+  double inv_eta_B = 0.0;
+  if (const double gap = phi_j_ - phi; gap > 0.0) {
+    double lg = 0.0;
+    bool have = false;
+    for (const rheology::EtaBTerm& t : steady_.eta_B_terms) inv_eta_B += t.phi_i * pow_term(gap, t.alpha, lg, have);
+  }
+  // Linearly implicit E24 step with end-of-step tau_bar, gamma_dot^p: f = (f_n + dt H' f_m)/(1 + dt (H' + S')),
+  // H' = K_0 gamma_dot^p (tau_bar/tau*)^{3/2}, S' = K_0 (gamma_dot^p + tau_bar/eta_B + xi_dot_eps); `stiff` = dt (H' + S').
+  auto f_next = [&](const ReturnMap& r, double& stiff) {
+    const double x = r.tau / tau_star_;
+    const double Hp = K_0_ * r.g * x * std::sqrt(x);
+    const double Sp = K_0_ * (r.g + r.tau * inv_eta_B + xi_dot_eps_);
+    stiff = dt * (Hp + Sp);
+    return std::clamp((fn + dt * Hp * fm) / (1.0 + stiff), 0.0, 1.0);
+  };
+
+  // ---- return map with f_n, then the structure update ----
+  ReturnMap r = return_map(fn, phi, eta_0, dt, p_tr, tau_tr);
+  double stiff = 0.0;
+  double f_used = fn;
+  double f_new = f_next(r, stiff);
+  const bool forced = out.jammed && options_.jammed_structure == JammedStructure::kForceOne;
+  if (forced) {
+    f_new = 1.0;
+  } else if (options_.structure_update == StructureUpdate::kImplicit ||
+             (options_.structure_update == StructureUpdate::kAuto && stiff > options_.stiff_structure)) {
+    // Monolithic backward Euler in f: find f with f = f_next(return_map(f)), i.e. phi_m, a of the return
+    // map and the E24 rates all at the end of the step. Z(f) = f - f_next(return_map(f)) has Z(0) <= 0 and
+    // Z(max(f_n, f_m)) >= 0 (f_next <= max(f_n, f_m)); the bracket starts at [f_n, staggered f] so that
+    // the root nearest the staggered prediction is found; Illinois iteration.
+    ReturnMap rz;
+    double dummy = 0.0;
+    auto Z = [&](double ff, ReturnMap& rr, double& fnext) {
+      rr = return_map(ff, phi, eta_0, dt, p_tr, tau_tr);
+      fnext = f_next(rr, dummy);
+      out.structure_iterations++;
+      return ff - fnext;
+    };
+    double a_f = fn, Za = fn - f_new;  // Z(f_n) from the staggered solve
+    ReturnMap ra = r;
+    double fa_next = f_new;
+    double b_f = f_new, fb_next = 0.0;
+    ReturnMap rb;
+    double Zb = Z(b_f, rb, fb_next);
+    if (Za != 0.0 && (Zb > 0.0) == (Za > 0.0) && Zb != 0.0) {  // no sign change: widen to the safe end
+      b_f = f_new > fn ? std::max(fn, fm) : 0.0;
+      Zb = Z(b_f, rb, fb_next);
+    }
+    bool ok = true;
+    if (Za == 0.0) {
+      rz = ra;
+      f_used = a_f;
+      f_new = fa_next;
+    } else if (Zb == 0.0 || (Zb > 0.0) == (Za > 0.0)) {
+      rz = rb;  // Zb == 0, or (only by round-off) no bracket: take the end point
+      f_used = b_f;
+      f_new = fb_next;
+      ok = std::fabs(Zb) <= 1e-12;
+    } else {
+      int side = 0;
+      ok = false;
+      for (int k = 0; k < options_.max_iter; ++k) {
+        double fc = (Za - Zb) != 0.0 ? (a_f * Zb - b_f * Za) / (Zb - Za) : 0.5 * (a_f + b_f);
+        if (!(fc > std::min(a_f, b_f) && fc < std::max(a_f, b_f))) fc = 0.5 * (a_f + b_f);
+        double fc_next = 0.0;
+        const double Zc = Z(fc, rz, fc_next);
+        f_used = fc;
+        f_new = fc_next;
+        if (std::fabs(Zc) <= 1e-13 || std::fabs(b_f - a_f) <= 1e-14) {
+          ok = true;
+          break;
+        }
+        if ((Zc > 0.0) == (Za > 0.0)) {
+          a_f = fc;
+          Za = Zc;
+          if (side == 1) Zb *= 0.5;
+          side = 1;
+        } else {
+          b_f = fc;
+          Zb = Zc;
+          if (side == -1) Za *= 0.5;
+          side = -1;
+        }
+      }
+    }
+    r = rz;
+    r.converged = r.converged && ok;
+    if (!ok) out.message = "implicit structure update did not converge within the iteration cap";
+  }
+  const double phi_m = phi_j_ + (phi_c_ - phi_j_) * f_used;  // E1 as used by the return map
+  const double a = a_0_ + (a_inf_ - a_0_) * f_used;          // E2
+  out.phi_m = phi_m;
+  const double tau = r.tau, p = r.p, g = r.g;
+  const GranularRegime regime = r.regime;
+
+  // ---- diagnostics E18–E20 at the end state ----
+  out.regime = regime;
+  out.gamma_dot_p = g;
+  out.xi_dot_1 = r.xi1;
+  out.xi_dot_2 = r.xi2;
+  if (p > 0.0 && g > 0.0) {
+    out.I_v = eta_0 * g / p;                      // E19
+    out.I = g * granular_.d * std::sqrt(granular_.rho_s / p);
+    out.I_m = std::sqrt(out.I * out.I + 2.0 * out.I_v);
+    out.phi_eq = phi_m / (1.0 + a * out.I_m);     // E18
+    out.beta = K_3_ * (phi - out.phi_eq);
+    out.mu_p = mu_q(out.I_m) + 2.5 * phi * out.I_v / (a * out.I_m);  // E20
+  } else if (p > 0.0 || regime == GranularRegime::kElastic) {
+    out.phi_eq = phi_m;
+    out.beta = K_3_ * (phi - phi_m);
+    out.mu_p = mu_q(0.0);
+  } else {  // p = 0: I_m -> infinity while flowing (reported as 0), phi_eq -> 0
+    out.phi_eq = g > 0.0 ? 0.0 : phi_m;
+    out.beta = g > 0.0 ? K_3_ * phi : K_3_ * (phi - phi_m);
+    out.mu_p = mu_q(0.0);
+  }
+  out.tau_bar = tau;
+  out.p = p;
+  out.iterations = r.iterations;
+  out.residual = r.residual;
+  out.converged = r.converged;
+
+  // ---- final stress: radial return in deviatoric space ----
+  Eigen::Matrix3d sig = (tau_tr > 0.0 ? tau / tau_tr : 0.0) * s_tr;
+  sig.diagonal().array() -= p;
+
+  if (!finite3(sig) || !std::isfinite(f_new) || !std::isfinite(g) || !std::isfinite(p)) {
+    out.finite = false;
+    out.message = "non-finite result (state left unchanged)";
+    return out;
+  }
+  if (!out.converged && out.message == nullptr) out.message = "return map did not converge within the iteration cap";
+  state.sigma = sig;
+  state.f = f_new;
+  return out;
+}
+
+std::string GranularLaw::describe(const GranularUpdate& u, const GranularState& before, const Eigen::Matrix3d& D,
+                                  const Eigen::Matrix3d& W, double dt, double phi) const {
+  auto mat = [](const Eigen::Matrix3d& m) {
+    return fmt::format("[[{:.17g}, {:.17g}, {:.17g}], [{:.17g}, {:.17g}, {:.17g}], [{:.17g}, {:.17g}, {:.17g}]]",
+                       m(0, 0), m(0, 1), m(0, 2), m(1, 0), m(1, 1), m(1, 2), m(2, 0), m(2, 1), m(2, 2));
+  };
+  return fmt::format(
+      "granular law (E16-E24, preset parameters: G = {} Pa, K = {} Pa, K_0 = {}, d = {} m, rho_s = {} kg/m^3): {}; "
+      "regime {}, iterations {}, relative residual {:.3g}; state before: f = {:.17g}, sigma = {} Pa; "
+      "inputs: phi = {:.17g}, dt = {:.17g} s, D = {} 1/s, W = {} 1/s; trial tau_bar = {:.6g} Pa, p = {:.6g} Pa; "
+      "result tau_bar = {:.6g} Pa, p = {:.6g} Pa, gamma_dot_p = {:.6g} 1/s",
+      G_, K_, K_0_, granular_.d, granular_.rho_s, u.message ? u.message : "ok", regime_name(u.regime),
+      u.iterations, u.residual, before.f, mat(before.sigma), phi, dt, mat(D), mat(W), u.tau_trial, u.p_trial,
+      u.tau_bar, u.p, u.gamma_dot_p);
+}
+
+void GranularLaw::require_ok(const GranularUpdate& u, const GranularState& before, const Eigen::Matrix3d& D,
+                             const Eigen::Matrix3d& W, double dt, double phi) const {
+  if (!u.ok()) throw NumericalError(describe(u, before, D, W, dt, phi));
+}
+
+}  // namespace oobleck::material

@@ -1,0 +1,109 @@
+#pragma once
+// Homogeneous material-point experiments with the granular law (model.md §3): simple shear at
+// fixed volume, rate- or stress-controlled, and stress relaxation after cessation of steady shear
+// (the SI's method for G and K_0) beside the SI's reduced ODE. Used by `oobleck point` and tests.
+#include <functional>
+#include <vector>
+
+#include "oobleck/material/granular.hpp"
+
+namespace oobleck::material {
+
+/// One recorded state of a point experiment.
+struct PointSample {
+  double time = 0.0;                   ///< [s]
+  double strain = 0.0;                 ///< accumulated shear strain gamma [-]
+  double shear_rate = 0.0;             ///< applied gamma_dot [1/s]
+  double shear_stress = 0.0;           ///< mixture tau = tau_bar + eta_0 (1 + 5 phi/2) gamma_dot [Pa]
+  double granular_shear_stress = 0.0;  ///< tau_bar [Pa]
+  double granular_pressure = 0.0;      ///< p~ [Pa]
+  double sigma_xy = 0.0;               ///< sigma~_xy [Pa]
+  double f = 0.0;                      ///< structure [-]
+  double phi = 0.0;                    ///< volume fraction (fixed) [-]
+  GranularRegime regime = GranularRegime::kElastic;
+  double gamma_dot_p = 0.0;  ///< [1/s]
+  double I_v = 0.0, I_m = 0.0, beta = 0.0, mu_p = 0.0, phi_eq = 0.0;
+  int iterations = 0;
+};
+
+/// Simple shear v_x = gamma_dot y at fixed volume (tr D = 0).
+struct ShearOptions {
+  double phi = 0.0;               ///< volume fraction [-]
+  bool stress_controlled = false;  ///< false: shear_rate imposed; true: shear_stress imposed
+  double shear_rate = 0.0;        ///< [1/s] (rate control)
+  double shear_stress = 0.0;      ///< mixture tau [Pa] (stress control)
+  double duration = 0.0;          ///< [s]
+  double dt = 0.0;                ///< [s]; <= 0 picks default_dt()
+  double f0 = 0.0;                ///< initial structure [-]
+  int samples = 1000;             ///< recorded rows (evenly spaced in time, plus the first and last)
+};
+
+struct ShearResult {
+  std::vector<PointSample> samples;
+  GranularState state;  ///< final state
+  double dt = 0.0;      ///< time step used [s]
+  long steps = 0;
+};
+
+/// Progress callback: fraction done in [0, 1] and the latest sample.
+using Progress = std::function<void(double, const PointSample&)>;
+
+/// Velocity gradient of simple shear: D and W for v_x = gamma_dot y.
+void simple_shear_rates(double gamma_dot, Eigen::Matrix3d& D, Eigen::Matrix3d& W);
+
+/// Default time step: resolves the shortest elastic relaxation time eta/G of the flow (eta the
+/// granular viscosity of the low-viscosity branch, E12) and 1e-3 strain per step, at most
+/// duration/1000 and at least duration/2e7 (a floor that is reported by the CLI).
+double default_dt(const GranularLaw& law, double phi, double shear_rate_scale, double duration);
+
+/// Run the shear experiment; throws NumericalError (describe()) if the law fails at any step.
+ShearResult run_shear(const GranularLaw& law, const ShearOptions& o, const Progress& progress = {});
+
+/// One stress-controlled step: the shear rate gamma_dot >= 0 for which the mixture shear stress
+/// tau_bar_{n+1}(gamma_dot) + eta_0 (1 + 5 phi/2) gamma_dot equals `stress` (bracketed Illinois
+/// solve; the law is called on copies of `state`). Returns the rate; `state`/`update` advanced.
+double stress_controlled_step(const GranularLaw& law, GranularState& state, double phi, double dt, double stress,
+                              GranularUpdate& update);
+
+/// Relaxation after cessation of steady shear.
+struct RelaxOptions {
+  double phi = 0.0;         ///< [-]
+  double shear_rate = 0.0;  ///< pre-shear rate [1/s] (rate-controlled pre-shear)
+  bool stress_controlled = false;  ///< pre-shear at imposed mixture shear stress instead
+  double shear_stress = 0.0;       ///< pre-shear mixture shear stress [Pa] (stress control)
+  double duration = 0.0;    ///< relaxation time span after cessation [s]
+  double dt = 0.0;          ///< first relaxation step [s]; <= 0: 1/20 of the initial relaxation time
+  double growth = 0.02;     ///< dt = max(dt0, growth * t) after cessation (log-time resolution)
+  int samples = 200;        ///< recorded rows (log-spaced in time)
+};
+
+struct RelaxSample {
+  double time = 0.0;
+  double tau_bar = 0.0, f = 0.0, p = 0.0, gamma_dot_p = 0.0;
+  GranularRegime regime = GranularRegime::kElastic;
+  double ode_tau_bar = 0.0, ode_f = 0.0;  ///< the SI reduced ODE at the same time
+};
+
+struct RelaxResult {
+  double G = 0.0, K_0 = 0.0;
+  double tau_bar_0 = 0.0, f_0 = 0.0, p_0 = 0.0;  ///< steady state before cessation
+  double relaxation_time_0 = 0.0;                ///< c(f_0) eta_0/G [s]
+  double preshear_strain = 0.0;
+  std::vector<RelaxSample> samples;
+};
+
+/// Closed-form steady shear rate at mixture shear stress `stress` (E11 swept in f; tau(f) is
+/// increasing), used to size pre-shear steps. Throws InputError if stress is out of range.
+double steady_rate_at_stress(const rheology::SteadyParams& s, double phi, double stress);
+
+/// Pre-shear to steady state (coarse steps: the backward-Euler return map has the exact steady
+/// state for any dt), then D = W = 0. `law` carries G and K_0.
+RelaxResult run_relax(const GranularLaw& law, const RelaxOptions& o, const Progress& progress = {});
+
+/// The SI's reduced relaxation ODE (model.md §3): d tau_bar/dt = -G gamma_dot^p,
+/// gamma_dot^p = tau_bar/(c(f) eta_0) with c(f) = mu_1 eta_n + (5/2) phi^2/(phi_m - phi) (E3–E5),
+/// f from E24. Integrated with classical RK4 on substeps of 1/20 of the fastest time scale.
+/// Advances (tau_bar, f) from t to t + span.
+void reduced_relax_ode(const GranularLaw& law, double phi, double span, double& tau_bar, double& f);
+
+}  // namespace oobleck::material
