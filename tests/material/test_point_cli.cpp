@@ -5,6 +5,7 @@
 #include <fstream>
 #include <string>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 
@@ -16,7 +17,9 @@ struct CliRun {
 };
 
 CliRun run(const std::string& args) {
-  const std::string log = std::filesystem::temp_directory_path() / "oobleck_point_cli.log";
+  // One log per test process: ctest runs tests of this file in parallel processes.
+  const std::string log = std::filesystem::temp_directory_path() /
+                          ("oobleck_point_cli_" + std::to_string(::getpid()) + ".log");
   const std::string cmd = std::string(OOBLECK_CLI) + " " + args + " > " + log + " 2>&1";
   const int rc = std::system(cmd.c_str());
   std::ifstream in(log);
@@ -24,7 +27,9 @@ CliRun run(const std::string& args) {
   return {WEXITSTATUS(rc), text};
 }
 
-std::string tmp(const std::string& name) { return std::filesystem::temp_directory_path() / name; }
+std::string tmp(const std::string& name) {
+  return std::filesystem::temp_directory_path() / (std::to_string(::getpid()) + "_" + name);
+}
 
 }  // namespace
 
