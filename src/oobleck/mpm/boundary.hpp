@@ -1,11 +1,26 @@
 #pragma once
-// Boundary conditions on nodal velocities (model.md §6 step 4, §7 walls).
+// Walls as mirror planes (model.md §6 step 4, §7 walls).
 //
-// Each non-periodic face carries one condition. It acts on every node of the face layer and of
-// the ghost layers beyond it (logical index ≤ 0 on a lower face, ≥ cells on an upper face), after
-// the grid update, so the FLIP increment and the APIC/PIC velocity both see it. Faces are applied
-// in order (axis 0 lower, axis 0 upper, axis 1 lower, …): at edges and corners the later face wins
-// for the components it sets.
+// Convention (docs/mpm.md): a wall lies on the face node plane of a non-periodic axis (logical
+// index 0 or cells). The shape functions are not modified near it; instead the two ghost layers
+// beyond it are *images* of the interior nodes, as if the material were reflected across the
+// wall (image-particle method):
+//   slip (frictionless):  normal component odd, tangential components even;
+//   no-slip:              all components odd (v_image = −v);
+//   prescribed velocity U: all components odd about U (v_image = 2U − v).
+// Two calls implement it:
+//   fold_wall_images()            after P2G + loads: what the real points scattered to a ghost node
+//                                 is added, reflected, to its interior mirror node (the wall node
+//                                 receives its own reflection), so interior nodes carry mass,
+//                                 momentum and force of points *and* their images;
+//   apply_boundary_conditions()   after the grid update: the wall node's constrained components
+//                                 are set exactly, and every ghost node's velocity (and FLIP's
+//                                 v_old) is set to the reflection of its mirror.
+// With B-splines this keeps the interior's second-order accuracy up to the wall (a one-sided
+// "ghost nodes = 0" treatment would add pinned mass and drop to low order). With linear weights it
+// reduces to the usual nodal condition. Faces are processed axis by axis, so corners get the
+// composition of the two reflections. An `Open` face imposes nothing (ghost nodes are plain nodes;
+// points may move at most one cell outside the domain).
 #include <array>
 
 #include "oobleck/mpm/geometry.hpp"
@@ -15,46 +30,116 @@
 namespace oobleck::mpm {
 
 enum class WallType {
-  Open,        ///< nothing imposed (points must stay within one cell of the domain)
+  Open,        ///< nothing imposed
   NoSlip,      ///< v = 0
-  Slip,        ///< frictionless, bilateral: normal component v_n = wall normal velocity (0)
-  Prescribed,  ///< every component v = velocity_m_s (moving wall, driven bob, …)
+  Slip,        ///< frictionless, bilateral: normal component v_n = U_n (tangential free)
+  Prescribed,  ///< every component v = U (moving wall, driven bob, …)
 };
 
 struct FaceCondition {
   WallType type = WallType::Open;
-  Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();  ///< wall velocity (components ≥ ncomp ignored)
+  Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();  ///< wall velocity U (components ≥ ncomp ignored)
 };
 
 /// Face index: 2a for the lower face of axis a, 2a + 1 for the upper face.
 template <int D>
 using BoundaryConditions = std::array<FaceCondition, 2 * D>;
 
+namespace detail {
+/// Reflection signs s_c (+1 even, −1 odd) of a face on axis a and the wall velocity U.
+template <int NC>
+void reflection(const FaceCondition& c, int a, Vec<NC>& s, Vec<NC>& U) {
+  s.setConstant(-1.0);
+  U.setZero();
+  if (c.type == WallType::Slip) {
+    s.setConstant(1.0);
+    s[a] = -1.0;
+    U[a] = c.velocity_m_s[a];
+  } else if (c.type == WallType::Prescribed) {
+    for (int k = 0; k < NC; ++k) U[k] = c.velocity_m_s[k];
+  }
+}
+
+/// Calls f(node, mirror_node, depth) for every node of a face's layers: depth 0 is the wall node
+/// (mirror = itself), depth j ≥ 1 the ghost node j layers outside (mirror = j layers inside).
+template <int D, class F>
+void for_face_layers(const Grid<D>& grid, int a, bool upper, F&& f) {
+  const int nn = grid.node_count();
+  const int N = grid.cells[a], st = grid.stride(a);
+#pragma omp parallel for schedule(static)
+  for (int n = 0; n < nn; ++n) {
+    const int i = grid.logical_index(a, grid.unflatten(n)[a]);
+    const int depth = upper ? i - N : -i;
+    if (depth < 0) continue;
+    const int mirror_i = upper ? N - depth : depth;
+    f(n, n + (mirror_i - i) * st, depth);
+  }
+}
+}  // namespace detail
+
+/// Add the reflected ghost-node contributions onto their interior mirrors (see header).
+template <class G>
+void fold_wall_images(const Grid<G::dim>& grid, const BoundaryConditions<G::dim>& bc, GridField<G>& field) {
+  constexpr int D = G::dim, NC = G::ncomp;
+  for (int a = 0; a < D; ++a) {
+    if (grid.periodic[a]) continue;
+    for (int side = 0; side < 2; ++side) {
+      const FaceCondition& c = bc[2 * a + side];
+      if (c.type == WallType::Open) continue;
+      Vec<NC> s, U;
+      detail::reflection<NC>(c, a, s, U);
+      const Vec<NC> one_minus_s = Vec<NC>::Ones() - s;
+      // Targets (depth 0 … ghost) and sources (ghost nodes and the wall node) are read before
+      // written: the wall node reads itself, mirror j ≥ 1 reads ghost j only.
+      detail::for_face_layers(grid, a, side == 1, [&](int ghost, int mirror, int depth) {
+        const double m = field.mass_kg[ghost];
+        const Vec<NC> p = field.momentum[ghost], f = field.force_N[ghost];
+        const Vec<NC> p_img = s.cwiseProduct(p) + m * one_minus_s.cwiseProduct(U);
+        const Vec<NC> f_img = s.cwiseProduct(f);
+        if (depth == 0) {
+          field.mass_kg[ghost] = 2.0 * m;
+          field.momentum[ghost] = p + p_img;
+          field.force_N[ghost] = f + f_img;
+        } else {
+          field.mass_kg[mirror] += m;
+          field.momentum[mirror] += p_img;
+          field.force_N[mirror] += f_img;
+        }
+      });
+    }
+  }
+}
+
+/// Impose the wall conditions on the updated nodal velocities and set the ghost nodes' velocities
+/// to the reflections of their mirrors (see header).
 template <class G>
 void apply_boundary_conditions(const Grid<G::dim>& grid, const BoundaryConditions<G::dim>& bc,
                                GridField<G>& field) {
   constexpr int D = G::dim, NC = G::ncomp;
-  const int nn = field.nodes();
-#pragma omp parallel for schedule(static)
-  for (int n = 0; n < nn; ++n) {
-    const auto s = grid.unflatten(n);
-    for (int a = 0; a < D; ++a) {
-      if (grid.periodic[a]) continue;
-      const int i = grid.logical_index(a, s[a]);
-      int face = -1;
-      if (i <= 0) face = 2 * a;
-      if (i >= grid.cells[a]) face = 2 * a + 1;
-      if (face < 0) continue;
-      const FaceCondition& c = bc[face];
-      Vec<NC>& v = field.velocity[n];
-      switch (c.type) {
-        case WallType::Open: break;
-        case WallType::NoSlip: v.setZero(); break;
-        case WallType::Slip: v[a] = c.velocity_m_s[a]; break;
-        case WallType::Prescribed:
-          for (int k = 0; k < NC; ++k) v[k] = c.velocity_m_s[k];
-          break;
-      }
+  for (int a = 0; a < D; ++a) {
+    if (grid.periodic[a]) continue;
+    for (int side = 0; side < 2; ++side) {
+      const FaceCondition& c = bc[2 * a + side];
+      if (c.type == WallType::Open) continue;
+      Vec<NC> s, U;
+      detail::reflection<NC>(c, a, s, U);
+      const Vec<NC> one_minus_s = Vec<NC>::Ones() - s;
+      // Wall node first (its odd components are fixed to U), then the ghosts from their mirrors.
+      detail::for_face_layers(grid, a, side == 1, [&](int node, int, int depth) {
+        if (depth != 0) return;
+        for (int k = 0; k < NC; ++k) {
+          if (s[k] < 0.0) {
+            field.velocity[node][k] = U[k];
+            field.velocity_old[node][k] = U[k];
+          }
+        }
+      });
+      detail::for_face_layers(grid, a, side == 1, [&](int ghost, int mirror, int depth) {
+        if (depth == 0) return;
+        field.velocity[ghost] = s.cwiseProduct(field.velocity[mirror]) + one_minus_s.cwiseProduct(U);
+        field.velocity_old[ghost] = s.cwiseProduct(field.velocity_old[mirror]) + one_minus_s.cwiseProduct(U);
+        field.mass_kg[ghost] = field.mass_kg[mirror];
+      });
     }
   }
 }

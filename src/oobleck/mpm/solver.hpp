@@ -106,9 +106,10 @@ class Solver {
       compute_shape_functions();           // 1. N_ip, ∇N_ip cached per point
       particles_to_grid_all<K>();          // 2. mass, momentum, internal force
       apply_body_loads();                  // 3. gravity (motors later)
+      fold_wall_images_all();              // 4a. walls: ghost contributions onto mirrors
       predict_grid_velocities();           // 5. v = (mv + Δt f)/m
       couple_bodies();                     // 3b. buoyancy, semi-implicit drag, contact (hook)
-      apply_boundary_conditions_all();     // 4. walls on nodal velocities
+      apply_boundary_conditions_all();     // 4b. walls on nodal velocities, ghost images
       grid_to_particles_all<K>();          // 6–7. x, v (FLIP/PIC or APIC), L, V ← V exp(Δt tr L)
       update_stresses();                   // 8. laws
     });
@@ -152,6 +153,10 @@ class Solver {
   void apply_body_loads() {
     if (opt_.gravity_m_s2.squaredNorm() == 0.0) return;
     for (auto& f : fields_) add_gravity(f, opt_.gravity_m_s2);
+  }
+
+  void fold_wall_images_all() {
+    for (auto& f : fields_) fold_wall_images<G>(grid_, bc_, f);
   }
 
   void predict_grid_velocities() {
