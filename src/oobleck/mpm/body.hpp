@@ -47,6 +47,9 @@ struct Body {
   std::vector<Mat<NC, D>> C_1_s;    ///< APIC affine velocity matrix (ncomp × dim)
   std::vector<Mat3> L_1_s;          ///< 3×3 velocity gradient of the last step (geometry terms incl.)
   std::vector<Mat3> stress_Pa;      ///< Cauchy stress, positive in tension
+  // Mixture fields interpolated from the nodes in G2P (fluid phase of a mixture only):
+  std::vector<double> phi;          ///< granular volume fraction 1 − n at the point
+  std::vector<double> div_q_1_s;    ///< div of the mixture volume flux q (E27)
   std::unique_ptr<StressLaw<G>> law;
 
   std::int64_t size() const { return static_cast<std::int64_t>(mass_kg.size()); }
@@ -61,6 +64,8 @@ struct Body {
     C_1_s.push_back(Mat<NC, D>::Zero());
     L_1_s.push_back(Mat3::Zero());
     stress_Pa.push_back(Mat3::Zero());
+    phi.push_back(0.0);
+    div_q_1_s.push_back(0.0);
     if (law) law->resize(size());
   }
 

@@ -12,7 +12,8 @@
 //   fold_wall_images()            after P2G + loads: what the real points scattered to a ghost node
 //                                 is added, reflected, to its interior mirror node (the wall node
 //                                 receives its own reflection), so interior nodes carry mass,
-//                                 momentum and force of points *and* their images;
+//                                 momentum, force (and the fluid's pressure force and mixture
+//                                 volume) of points *and* their images;
 //   apply_boundary_conditions()   after the grid update: the wall node's constrained components
 //                                 are set exactly, and every ghost node's velocity (and FLIP's
 //                                 v_old) is set to the reflection of its mirror.
@@ -96,14 +97,20 @@ void fold_wall_images(const Grid<G::dim>& grid, const BoundaryConditions<G::dim>
         const Vec<NC> p = field.momentum[ghost], f = field.force_N[ghost];
         const Vec<NC> p_img = s.cwiseProduct(p) + m * one_minus_s.cwiseProduct(U);
         const Vec<NC> f_img = s.cwiseProduct(f);
+        const Vec<NC> fp_img = s.cwiseProduct(field.pressure_force_N[ghost]);
+        const double V = field.volume_m3[ghost];
         if (depth == 0) {
           field.mass_kg[ghost] = 2.0 * m;
           field.momentum[ghost] = p + p_img;
           field.force_N[ghost] = f + f_img;
+          field.pressure_force_N[ghost] += fp_img;
+          field.volume_m3[ghost] = 2.0 * V;
         } else {
           field.mass_kg[mirror] += m;
           field.momentum[mirror] += p_img;
           field.force_N[mirror] += f_img;
+          field.pressure_force_N[mirror] += fp_img;
+          field.volume_m3[mirror] += V;
         }
       });
     }

@@ -9,6 +9,7 @@
 // Each body has its own grid field; the phase coupling (buoyancy split, semi-implicit drag,
 // model.md §5) and contact (§8) plug into `couple_bodies()` between the predicted grid velocities
 // and the boundary conditions.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -21,6 +22,7 @@
 #include <fmt/format.h>
 
 #include "oobleck/core/error.hpp"
+#include "oobleck/material/drag.hpp"
 #include "oobleck/mpm/body.hpp"
 #include "oobleck/mpm/boundary.hpp"
 #include "oobleck/mpm/grid.hpp"
@@ -28,6 +30,21 @@
 #include "oobleck/mpm/transfer.hpp"
 
 namespace oobleck::mpm {
+
+/// Role of a body: a single-phase solid, or the granular or fluid phase of the mixture.
+enum class Phase { Solid, Grains, Fluid };
+
+/// Two-phase mixture parameters (model.md §5), used when a Grains and a Fluid body exist.
+template <class G>
+struct MixtureOptions {
+  double rho_s_kg_m3 = 1620.0;     ///< grain true density ρ_s
+  double rho_f0_kg_m3 = 1000.0;    ///< fluid rest density ρ_f0 (Re uses the nodal ρ_f)
+  double min_porosity = 0.01;      ///< lower clamp of the nodal porosity n_i [base]
+  material::DragParams drag;       ///< E29 (d, η_0, law)
+  /// Imposed uniform background pressure gradient ∇p_0 [Pa/m], split like the fluid pressure
+  /// (grains (1−n), fluid n). Periodic boxes use ∇p_0 = ρ_mix g to carry the mixture's weight.
+  Vec<G::ncomp> background_pressure_gradient_Pa_m = Vec<G::ncomp>::Zero();
+};
 
 template <class G>
 struct SolverOptions {
@@ -38,6 +55,7 @@ struct SolverOptions {
   double flip_fraction = 0.99;                          ///< α of the FLIP/PIC blend
   Vec<G::ncomp> gravity_m_s2 = Vec<G::ncomp>::Zero();   ///< gravitational acceleration
   int threads = 0;                                      ///< OpenMP threads (0: omp default)
+  MixtureOptions<G> mixture;                            ///< used only with Grains + Fluid bodies
 };
 
 /// Number of nodes per axis in the support of a kernel.
@@ -66,7 +84,17 @@ class Solver {
     threads_ = opt_.threads > 0 ? opt_.threads : omp_get_max_threads();
   }
 
-  Body<G>& add_body(const std::string& name) {
+  /// Add a body. At most one Grains and one Fluid body (they are coupled at the nodes).
+  Body<G>& add_body(const std::string& name, Phase phase = Phase::Solid) {
+    const int index = static_cast<int>(bodies_.size());
+    if (phase == Phase::Grains) {
+      if (grains_ >= 0) throw InputError("mpm: only one granular body per solver");
+      grains_ = index;
+    }
+    if (phase == Phase::Fluid) {
+      if (fluid_ >= 0) throw InputError("mpm: only one fluid body per solver");
+      fluid_ = index;
+    }
     bodies_.push_back(std::make_unique<Body<G>>());
     bodies_.back()->name = name;
     caches_.emplace_back();
@@ -83,6 +111,8 @@ class Solver {
   const GridField<G>& field(int b) const { return fields_[b]; }
   const ShapeCache<D>& shape_cache(int b) const { return caches_[b]; }
   double time_s() const { return time_s_; }
+  /// Nodal porosity of the last step (mixture only; empty otherwise).
+  const std::vector<double>& nodal_porosity() const { return porosity_; }
   std::int64_t steps() const { return steps_; }
   int threads() const { return threads_; }
 
@@ -107,9 +137,11 @@ class Solver {
       particles_to_grid_all<K>();          // 2. mass, momentum, internal force
       apply_body_loads();                  // 3. gravity (motors later)
       fold_wall_images_all();              // 4a. walls: ghost contributions onto mirrors
-      predict_grid_velocities();           // 5. v = (mv + Δt f)/m
-      couple_bodies();                     // 3b. buoyancy, semi-implicit drag, contact (hook)
+      apply_mixture_forces();              // 3a. porosity n_i, buoyancy split E28, ∇p_0
+      predict_grid_velocities();           // 5. v = (mv + Δt f)/m with all non-drag forces
+      apply_drag();                        // 3b. semi-implicit E29 drag (contact §8 later)
       apply_boundary_conditions_all();     // 4b. walls on nodal velocities, ghost images
+      compute_mixture_flux();              //     q_i = (1−n_i) v^s_i + n_i v^f_i for E27
       grid_to_particles_all<K>();          // 6–7. x, v (FLIP/PIC or APIC), L, V ← V exp(Δt tr L)
       update_stresses();                   // 8. laws
     });
@@ -147,7 +179,71 @@ class Solver {
   void particles_to_grid_all() {
     const bool apic = opt_.transfer == Transfer::Apic;
     for (std::size_t b = 0; b < bodies_.size(); ++b)
-      particles_to_grid<G, K>(*bodies_[b], caches_[b], fields_[b], apic);
+      particles_to_grid<G, K>(*bodies_[b], caches_[b], fields_[b], apic,
+                              mixture() && static_cast<int>(b) == fluid_);
+  }
+
+  bool mixture() const { return grains_ >= 0 && fluid_ >= 0; }
+
+  /// Nodal porosity n_i = 1 − m^s_i/(ρ_s V_i) (clamped to [n_min, 1]; 1 where there are no grains),
+  /// then the pressure force ∑ V p ∇N split: grains (1 − n_i), fluid n_i (E28), and the same split
+  /// of a background gradient −V_i ∇p_0. The viscous τ_f already acts on the fluid alone.
+  void apply_mixture_forces() {
+    if (!mixture()) return;
+    GridField<G>& s = fields_[grains_];
+    GridField<G>& f = fields_[fluid_];
+    const auto& mx = opt_.mixture;
+    const int nn = f.nodes();
+    porosity_.resize(static_cast<std::size_t>(nn));
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < nn; ++i) {
+      const double V = f.volume_m3[i];
+      double n = 1.0;
+      if (V > 0.0 && s.mass_kg[i] > 0.0) n = std::clamp(1.0 - s.mass_kg[i] / (mx.rho_s_kg_m3 * V), mx.min_porosity, 1.0);
+      porosity_[i] = n;
+      const Vec<NC> Fp = f.pressure_force_N[i] - V * mx.background_pressure_gradient_Pa_m;
+      s.force_N[i] += (1.0 - n) * Fp;
+      f.force_N[i] += n * Fp;
+    }
+  }
+
+  /// Semi-implicit drag per node (model.md §5): C_i = V_i C_V(φ_i, Re_i) with the predicted
+  /// velocities, F_d = C_i/(1 + Δt C_i (1/m_s + 1/m_f)) Δv; grains −F_d, fluid +F_d.
+  void apply_drag() {
+    if (!mixture()) return;
+    GridField<G>& s = fields_[grains_];
+    GridField<G>& f = fields_[fluid_];
+    const auto& mx = opt_.mixture;
+    const double dt = opt_.dt_s;
+    const int nn = f.nodes();
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < nn; ++i) {
+      const double ms = s.mass_kg[i], mf = f.mass_kg[i], V = f.volume_m3[i];
+      if (!(ms > 0.0 && mf > 0.0 && V > 0.0)) continue;
+      const double n = porosity_[i];
+      const Vec<NC> dv = s.velocity[i] - f.velocity[i];
+      const double rho_f = mf / (n * V);
+      const double Re = material::drag_reynolds(dv.norm(), n, rho_f, mx.drag.d_m, mx.drag.eta_0_Pa_s);
+      const double C = V * material::drag_coefficient_per_volume(mx.drag, 1.0 - n, Re);
+      const Vec<NC> Fd = material::semi_implicit_drag_force(ms, mf, s.velocity[i], f.velocity[i], C, dt);
+      s.velocity[i] -= (dt / ms) * Fd;
+      f.velocity[i] += (dt / mf) * Fd;
+      s.force_N[i] -= Fd;  // kept for output/diagnostics
+      f.force_N[i] += Fd;
+    }
+  }
+
+  void compute_mixture_flux() {
+    if (!mixture()) return;
+    const GridField<G>& s = fields_[grains_];
+    const GridField<G>& f = fields_[fluid_];
+    const int nn = f.nodes();
+    flux_.resize(static_cast<std::size_t>(nn));
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < nn; ++i) {
+      const double n = porosity_[i];
+      flux_[i] = (1.0 - n) * s.velocity[i] + n * f.velocity[i];
+    }
   }
 
   void apply_body_loads() {
@@ -163,8 +259,6 @@ class Solver {
     for (auto& f : fields_) update_grid_velocity(f, opt_.dt_s);
   }
 
-  void couple_bodies() {}  // single-phase bodies: nothing yet (model.md §5, §8 plug in here)
-
   void apply_boundary_conditions_all() {
     for (auto& f : fields_) apply_boundary_conditions<G>(grid_, bc_, f);
   }
@@ -173,7 +267,9 @@ class Solver {
   void grid_to_particles_all() {
     for (std::size_t b = 0; b < bodies_.size(); ++b)
       grid_to_particles<G, K>(*bodies_[b], caches_[b], fields_[b], grid_, opt_.transfer,
-                              opt_.flip_fraction, opt_.dt_s);
+                              opt_.flip_fraction, opt_.dt_s,
+                              mixture() && static_cast<int>(b) == fluid_ ? porosity_.data() : nullptr,
+                              mixture() && static_cast<int>(b) == fluid_ ? flux_.data() : nullptr);
   }
 
   void update_stresses() {
@@ -188,6 +284,9 @@ class Solver {
   std::vector<ShapeCache<D>> caches_;
   std::vector<GridField<G>> fields_;
   int threads_ = 1;
+  int grains_ = -1, fluid_ = -1;
+  std::vector<double> porosity_;  ///< nodal porosity n_i of the mixture
+  std::vector<Vec<NC>> flux_;     ///< nodal mixture volume flux q_i
   double time_s_ = 0.0;
   std::int64_t steps_ = 0;
 };

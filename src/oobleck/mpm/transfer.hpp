@@ -30,9 +30,13 @@ struct GridField {
   std::vector<Vec<NC>> force_N;       ///< internal + body forces (+ coupling) [N]
   std::vector<Vec<NC>> velocity_old;  ///< momentum/mass before the force update [m/s]
   std::vector<Vec<NC>> velocity;      ///< updated velocity after boundary conditions [m/s]
+  // Fluid phase only (P2G with `split_pressure`): ∑_p V_p p_p ∇N_ip [N] (split by porosity, E28)
+  // and the nodal mixture volume ∑_p N_ip V_p [m^D].
+  std::vector<Vec<NC>> pressure_force_N;
+  std::vector<double> volume_m3;
   // Per-thread scatter copies for threads 1 … T−1 (thread 0 writes into the arrays above).
-  std::vector<std::vector<double>> t_mass;
-  std::vector<std::vector<Vec<NC>>> t_momentum, t_force;
+  std::vector<std::vector<double>> t_mass, t_volume;
+  std::vector<std::vector<Vec<NC>>> t_momentum, t_force, t_pressure;
 
   void resize(int nodes, int threads) {
     const auto n = static_cast<std::size_t>(nodes);
@@ -41,10 +45,14 @@ struct GridField {
     force_N.assign(n, Vec<NC>::Zero());
     velocity_old.assign(n, Vec<NC>::Zero());
     velocity.assign(n, Vec<NC>::Zero());
+    pressure_force_N.assign(n, Vec<NC>::Zero());
+    volume_m3.assign(n, 0.0);
     const auto extra = static_cast<std::size_t>(threads > 1 ? threads - 1 : 0);
     t_mass.assign(extra, std::vector<double>(n, 0.0));
     t_momentum.assign(extra, std::vector<Vec<NC>>(n, Vec<NC>::Zero()));
     t_force.assign(extra, std::vector<Vec<NC>>(n, Vec<NC>::Zero()));
+    t_pressure.assign(extra, std::vector<Vec<NC>>(n, Vec<NC>::Zero()));
+    t_volume.assign(extra, std::vector<double>(n, 0.0));
   }
   int nodes() const { return static_cast<int>(mass_kg.size()); }
   int max_threads() const { return static_cast<int>(t_mass.size()) + 1; }
@@ -52,8 +60,12 @@ struct GridField {
 
 /// P2G (model.md §6 step 2): nodal mass, momentum (with the APIC affine term when `apic`), and
 /// internal force f_i = −∑_p V_p σ_p ∇N_ip. K = local nodes per point (support^dim).
+/// With `split_pressure` (the fluid phase) the stress is split as σ = τ − p 1 (p = −tr σ/3): the
+/// internal force gets only τ, the pressure part ∑ V_p p_p ∇N_ip goes to `pressure_force_N` for the
+/// buoyancy split (E28), and the nodal mixture volume ∑ N_ip V_p is accumulated.
 template <class G, int K>
-void particles_to_grid(const Body<G>& body, const ShapeCache<G::dim>& cache, GridField<G>& field, bool apic) {
+void particles_to_grid(const Body<G>& body, const ShapeCache<G::dim>& cache, GridField<G>& field, bool apic,
+                       bool split_pressure = false) {
   constexpr int D = G::dim, NC = G::ncomp;
   const std::int64_t np = body.size();
   const int nn = field.nodes();
@@ -66,17 +78,32 @@ void particles_to_grid(const Body<G>& body, const ShapeCache<G::dim>& cache, Gri
     double* m = t == 0 ? field.mass_kg.data() : field.t_mass[t - 1].data();
     Vec<NC>* mv = t == 0 ? field.momentum.data() : field.t_momentum[t - 1].data();
     Vec<NC>* f = t == 0 ? field.force_N.data() : field.t_force[t - 1].data();
+    Vec<NC>* fp = t == 0 ? field.pressure_force_N.data() : field.t_pressure[t - 1].data();
+    double* vol = t == 0 ? field.volume_m3.data() : field.t_volume[t - 1].data();
     for (int i = 0; i < nn; ++i) {
       m[i] = 0.0;
       mv[i].setZero();
       f[i].setZero();
+    }
+    if (split_pressure) {
+      for (int i = 0; i < nn; ++i) {
+        fp[i].setZero();
+        vol[i] = 0.0;
+      }
     }
 #pragma omp for schedule(static)
     for (std::int64_t p = 0; p < np; ++p) {
       const double mp = body.mass_kg[p], Vp = body.volume_m3[p];
       const Vec<NC> vp = body.v_m_s[p];
       const Mat<NC, D> Cp = body.C_1_s[p];
-      const Mat<NC, D> Vsig = Vp * body.stress_Pa[p].template topLeftCorner<NC, D>();
+      Mat3 sig = body.stress_Pa[p];
+      double Vpres = 0.0;
+      if (split_pressure) {
+        const double pres = -sig.trace() / 3.0;
+        sig.diagonal().array() += pres;  // τ = σ + p 1
+        Vpres = Vp * pres;
+      }
+      const Mat<NC, D> Vsig = Vp * sig.template topLeftCorner<NC, D>();
       const std::int64_t o = p * K;
       for (int k = 0; k < K; ++k) {
         const int i = cache.node[o + k];
@@ -88,6 +115,10 @@ void particles_to_grid(const Body<G>& body, const ShapeCache<G::dim>& cache, Gri
           mv[i] += (w * mp) * vp;
         }
         f[i] -= Vsig * cache.grad[o + k];
+        if (split_pressure) {
+          fp[i].template head<D>() += Vpres * cache.grad[o + k];
+          vol[i] += w * Vp;
+        }
       }
     }
   }
@@ -98,6 +129,10 @@ void particles_to_grid(const Body<G>& body, const ShapeCache<G::dim>& cache, Gri
         field.mass_kg[i] += field.t_mass[t - 1][i];
         field.momentum[i] += field.t_momentum[t - 1][i];
         field.force_N[i] += field.t_force[t - 1][i];
+        if (split_pressure) {
+          field.pressure_force_N[i] += field.t_pressure[t - 1][i];
+          field.volume_m3[i] += field.t_volume[t - 1][i];
+        }
       }
     }
   }
@@ -132,9 +167,14 @@ void update_grid_velocity(GridField<G>& field, double dt_s) {
 /// the FLIP/PIC blend v ← α (v + ∑N (v_i − v_i^old)) + (1 − α) ∑N v_i or by APIC (v ← ∑N v_i,
 /// C ← B D⁻¹, or ∑ v_i ∇Nᵀ for linear weights), and the velocity gradient L = ∑ v_i ∇Nᵀ (plus
 /// geometry terms). Also the volume update V ← V exp(Δt tr L) (step 7), fused into the same loop.
+///
+/// For the fluid phase of a mixture, `porosity` (n_i) and `mixture_flux` (q_i = (1−n_i) v^s_i +
+/// n_i v^f_i) are given; the point's φ = 1 − ∑N n_i and div q = ∑ q_i·∇N_ip are stored in
+/// body.phi and body.div_q_1_s for the fluid law (E25, E27).
 template <class G, int K>
 void grid_to_particles(Body<G>& body, const ShapeCache<G::dim>& cache, const GridField<G>& field,
-                       const Grid<G::dim>& grid, Transfer transfer, double flip_fraction, double dt_s) {
+                       const Grid<G::dim>& grid, Transfer transfer, double flip_fraction, double dt_s,
+                       const double* porosity = nullptr, const Vec<G::ncomp>* mixture_flux = nullptr) {
   constexpr int D = G::dim, NC = G::ncomp;
   const std::int64_t np = body.size();
   const bool apic = transfer == Transfer::Apic;
@@ -144,11 +184,16 @@ void grid_to_particles(Body<G>& body, const ShapeCache<G::dim>& cache, const Gri
   for (std::int64_t p = 0; p < np; ++p) {
     Vec<NC> v_pic = Vec<NC>::Zero(), dv = Vec<NC>::Zero();
     Mat<NC, D> grad_v = Mat<NC, D>::Zero(), B = Mat<NC, D>::Zero();
+    double n_p = 0.0, div_q = 0.0;
     const std::int64_t o = p * K;
     for (int k = 0; k < K; ++k) {
       const int i = cache.node[o + k];
       const double w = cache.w[o + k];
       const Vec<NC>& vi = field.velocity[i];
+      if (porosity) {
+        n_p += w * porosity[i];
+        div_q += mixture_flux[i].template head<D>().dot(cache.grad[o + k]);
+      }
       v_pic += w * vi;
       grad_v += vi * cache.grad[o + k].transpose();
       if (apic) {
@@ -165,6 +210,10 @@ void grid_to_particles(Body<G>& body, const ShapeCache<G::dim>& cache, const Gri
       body.C_1_s[p] = by_grad ? grad_v : Mat<NC, D>(B * cache.inv_D[p].asDiagonal());
     } else {
       body.v_m_s[p] = alpha * (body.v_m_s[p] + dv) + (1.0 - alpha) * v_pic;
+    }
+    if (porosity) {
+      body.phi[p] = 1.0 - n_p;
+      body.div_q_1_s[p] = div_q;
     }
     const Mat3 L = G::velocity_gradient(grad_v, x, body.v_m_s[p]);
     body.L_1_s[p] = L;
