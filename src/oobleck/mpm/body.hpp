@@ -5,6 +5,7 @@
 // Each field is one contiguous array over the points. Per-law state (e.g. f and φ of the granular
 // phase, J of the fluid) lives in the law object attached to the body, again one array per
 // variable; the law updates the body's stress from the body's velocity gradient once per step.
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -29,6 +30,9 @@ class StressLaw {
   virtual void update_stress(Body<G>& body, double dt_s) = 0;
   /// Fastest wave speed [m/s] at the current state (for the stable time step, model.md §6).
   virtual double max_wave_speed(const Body<G>& body) const = 0;
+  /// Largest stable Δt [s] of the law's own diffusion on a grid of cell size h (viscous limit
+  /// ρ h²/(2η), model.md §6); +∞ for laws without one.
+  virtual double viscous_dt_limit(const Body<G>& /*body*/, double /*h_m*/) const { return INFINITY; }
   /// Short name for messages.
   virtual const char* name() const = 0;
 };

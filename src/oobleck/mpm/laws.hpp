@@ -57,6 +57,11 @@ class FluidLaw final : public StressLaw<G> {
     for (double j : J) J_max = std::max(J_max, j);
     return material::fluid_wave_speed(p_.kappa_Pa, p_.rho_f0_kg_m3 / J_max);
   }
+  double viscous_dt_limit(const Body<G>& body, double h_m) const override {
+    double phi_max = 0.0;
+    for (double f : body.phi) phi_max = std::max(phi_max, f);
+    return p_.rho_f0_kg_m3 * h_m * h_m / (2.0 * material::fluid_effective_viscosity(p_.eta_0_Pa_s, phi_max));
+  }
   const char* name() const override { return "fluid"; }
   const material::FluidParams& params() const { return p_; }
   std::vector<double> J;  ///< ρ_f0/ρ_f per point

@@ -116,17 +116,19 @@ class Solver {
   std::int64_t steps() const { return steps_; }
   int threads() const { return threads_; }
 
-  /// Largest stable Δt [s] from the CFL condition on the fastest wave of every body
-  /// (Δt ≤ cfl h / (c + |v|_max), model.md §6).
+  /// Largest stable Δt [s]: the CFL condition on the fastest wave of every body
+  /// (Δt ≤ cfl h / (c + |v|_max)) and the laws' viscous limits ρ h²/(2η) (model.md §6). The
+  /// drag is semi-implicit and never limits Δt.
   double stable_dt(double cfl = 0.5) const {
-    double c_max = 0.0;
+    double c_max = 0.0, dt_visc = INFINITY;
     for (const auto& b : bodies_) {
       double c = b->law ? b->law->max_wave_speed(*b) : 0.0;
       double vmax = 0.0;
       for (const auto& v : b->v_m_s) vmax = std::max(vmax, v.norm());
       c_max = std::max(c_max, c + vmax);
+      if (b->law) dt_visc = std::min(dt_visc, b->law->viscous_dt_limit(*b, grid_.h_m));
     }
-    return c_max > 0.0 ? cfl * grid_.h_m / c_max : INFINITY;
+    return std::min(c_max > 0.0 ? cfl * grid_.h_m / c_max : INFINITY, dt_visc);
   }
 
   /// One explicit step of length options().dt_s.
@@ -179,8 +181,7 @@ class Solver {
   void particles_to_grid_all() {
     const bool apic = opt_.transfer == Transfer::Apic;
     for (std::size_t b = 0; b < bodies_.size(); ++b)
-      particles_to_grid<G, K>(*bodies_[b], caches_[b], fields_[b], apic,
-                              mixture() && static_cast<int>(b) == fluid_);
+      particles_to_grid<G, K>(*bodies_[b], caches_[b], fields_[b], apic, static_cast<int>(b) == fluid_);
   }
 
   bool mixture() const { return grains_ >= 0 && fluid_ >= 0; }
@@ -188,10 +189,12 @@ class Solver {
   /// Nodal porosity n_i = 1 − m^s_i/(ρ_s V_i) (clamped to [n_min, 1]; 1 where there are no grains),
   /// then the pressure force ∑ V p ∇N split: grains (1 − n_i), fluid n_i (E28), and the same split
   /// of a background gradient −V_i ∇p_0. The viscous τ_f already acts on the fluid alone.
+  /// Without a granular body (fluid only) n_i = 1 and the whole pressure force acts on the fluid.
   void apply_mixture_forces() {
-    if (!mixture()) return;
-    GridField<G>& s = fields_[grains_];
+    if (fluid_ < 0) return;
+    GridField<G>& s = fields_[grains_ >= 0 ? grains_ : fluid_];
     GridField<G>& f = fields_[fluid_];
+    const bool grains = grains_ >= 0;
     const auto& mx = opt_.mixture;
     const int nn = f.nodes();
     porosity_.resize(static_cast<std::size_t>(nn));
@@ -199,10 +202,11 @@ class Solver {
     for (int i = 0; i < nn; ++i) {
       const double V = f.volume_m3[i];
       double n = 1.0;
-      if (V > 0.0 && s.mass_kg[i] > 0.0) n = std::clamp(1.0 - s.mass_kg[i] / (mx.rho_s_kg_m3 * V), mx.min_porosity, 1.0);
+      if (grains && V > 0.0 && s.mass_kg[i] > 0.0)
+        n = std::clamp(1.0 - s.mass_kg[i] / (mx.rho_s_kg_m3 * V), mx.min_porosity, 1.0);
       porosity_[i] = n;
       const Vec<NC> Fp = f.pressure_force_N[i] - V * mx.background_pressure_gradient_Pa_m;
-      s.force_N[i] += (1.0 - n) * Fp;
+      if (grains) s.force_N[i] += (1.0 - n) * Fp;
       f.force_N[i] += n * Fp;
     }
   }
@@ -234,8 +238,8 @@ class Solver {
   }
 
   void compute_mixture_flux() {
-    if (!mixture()) return;
-    const GridField<G>& s = fields_[grains_];
+    if (fluid_ < 0) return;
+    const GridField<G>& s = fields_[grains_ >= 0 ? grains_ : fluid_];  // n = 1 without grains
     const GridField<G>& f = fields_[fluid_];
     const int nn = f.nodes();
     flux_.resize(static_cast<std::size_t>(nn));
@@ -268,8 +272,8 @@ class Solver {
     for (std::size_t b = 0; b < bodies_.size(); ++b)
       grid_to_particles<G, K>(*bodies_[b], caches_[b], fields_[b], grid_, opt_.transfer,
                               opt_.flip_fraction, opt_.dt_s,
-                              mixture() && static_cast<int>(b) == fluid_ ? porosity_.data() : nullptr,
-                              mixture() && static_cast<int>(b) == fluid_ ? flux_.data() : nullptr);
+                              static_cast<int>(b) == fluid_ ? porosity_.data() : nullptr,
+                              static_cast<int>(b) == fluid_ ? flux_.data() : nullptr);
   }
 
   void update_stresses() {
