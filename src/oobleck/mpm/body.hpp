@@ -99,7 +99,8 @@ struct Body {
 };
 
 /// Fill a box [lo, hi] with points on a regular lattice of `ppc` points per cell per axis
-/// (cell size h), all of density ρ, velocity from v(x).
+/// (cell size h), all of density ρ, velocity from v(x). Point volume from the geometry's measure
+/// (per radian, A r, in axisymmetric mode).
 template <class G, class VFun>
 void fill_box(Body<G>& body, const Vec<G::dim>& lo, const Vec<G::dim>& hi, double h_m, int ppc,
               double density_kg_m3, VFun&& velocity) {
@@ -121,7 +122,7 @@ void fill_box(Body<G>& body, const Vec<G::dim>& lo, const Vec<G::dim>& hi, doubl
       rem /= n[a];
       x[a] = lo[a] + (static_cast<double>(i) + 0.5) * dx;
     }
-    body.add_point(x, vol, density_kg_m3, velocity(x));
+    body.add_point(x, G::measure(x, vol), density_kg_m3, velocity(x));
   }
 }
 

@@ -7,7 +7,8 @@
 // wall (image-particle method):
 //   slip (frictionless):  normal component odd, tangential components even;
 //   no-slip:              all components odd (v_image = −v);
-//   prescribed velocity U: all components odd about U (v_image = 2U − v).
+//   prescribed velocity U: all components odd about U (v_image = 2U − v);
+//   axis (r = 0, axisymmetric): v_r and v_θ odd, v_z even (masses per radian ∝ |r| mirror evenly).
 // Two calls implement it:
 //   fold_wall_images()            after P2G + loads: what the real points scattered to a ghost node
 //                                 is added, reflected, to its interior mirror node (the wall node
@@ -35,6 +36,7 @@ enum class WallType {
   NoSlip,      ///< v = 0
   Slip,        ///< frictionless, bilateral: normal component v_n = U_n (tangential free)
   Prescribed,  ///< every component v = U (moving wall, driven bob, …)
+  Axis,        ///< symmetry axis r = 0 (axisymmetric): v_r = v_θ = 0, v_z free
 };
 
 struct FaceCondition {
@@ -48,11 +50,15 @@ using BoundaryConditions = std::array<FaceCondition, 2 * D>;
 
 namespace detail {
 /// Reflection signs s_c (+1 even, −1 odd) of a face on axis a and the wall velocity U.
-template <int NC>
+template <int NC, int D>
 void reflection(const FaceCondition& c, int a, Vec<NC>& s, Vec<NC>& U) {
   s.setConstant(-1.0);
   U.setZero();
-  if (c.type == WallType::Slip) {
+  if (c.type == WallType::Axis) {  // mirror through the axis: v_r and v_θ odd, v_z even
+    s.setConstant(1.0);
+    s[a] = -1.0;
+    if constexpr (NC > D) s[NC - 1] = -1.0;
+  } else if (c.type == WallType::Slip) {
     s.setConstant(1.0);
     s[a] = -1.0;
     U[a] = c.velocity_m_s[a];
@@ -88,7 +94,7 @@ void fold_wall_images(const Grid<G::dim>& grid, const BoundaryConditions<G::dim>
       const FaceCondition& c = bc[2 * a + side];
       if (c.type == WallType::Open) continue;
       Vec<NC> s, U;
-      detail::reflection<NC>(c, a, s, U);
+      detail::reflection<NC, D>(c, a, s, U);
       const Vec<NC> one_minus_s = Vec<NC>::Ones() - s;
       // Targets (depth 0 … ghost) and sources (ghost nodes and the wall node) are read before
       // written: the wall node reads itself, mirror j ≥ 1 reads ghost j only.
@@ -129,7 +135,7 @@ void apply_boundary_conditions(const Grid<G::dim>& grid, const BoundaryCondition
       const FaceCondition& c = bc[2 * a + side];
       if (c.type == WallType::Open) continue;
       Vec<NC> s, U;
-      detail::reflection<NC>(c, a, s, U);
+      detail::reflection<NC, D>(c, a, s, U);
       const Vec<NC> one_minus_s = Vec<NC>::Ones() - s;
       // Wall node first (its odd components are fixed to U), then the ghosts from their mirrors.
       detail::for_face_layers(grid, a, side == 1, [&](int node, int, int depth) {

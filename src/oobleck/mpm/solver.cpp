@@ -6,6 +6,11 @@
 namespace oobleck::mpm {
 template class Solver<PlaneStrain>;
 template class Solver<ThreeD>;
+template class Solver<Axisymmetric>;
 template class LinearElasticLaw<PlaneStrain>;
 template class LinearElasticLaw<ThreeD>;
+template class LinearElasticLaw<Axisymmetric>;
+template class FluidLaw<PlaneStrain>;
+template class FluidLaw<Axisymmetric>;
+template class FluidLaw<ThreeD>;
 }  // namespace oobleck::mpm

@@ -104,6 +104,13 @@ void particles_to_grid(const Body<G>& body, const ShapeCache<G::dim>& cache, Gri
         Vpres = Vp * pres;
       }
       const Mat<NC, D> Vsig = Vp * sig.template topLeftCorner<NC, D>();
+      // Axisymmetric: hoop and inertial terms, applied with weight N_ip (zero-cost otherwise).
+      Vec<NC> f_point = Vec<NC>::Zero(), fp_point = Vec<NC>::Zero();
+      if constexpr (G::has_hoop_terms) {
+        const Vec<D>& xp = body.x_m[p];
+        f_point = G::hoop_force(sig, xp, Vp) + mp * G::inertial_acceleration(xp, vp);
+        if (split_pressure) fp_point = G::hoop_force(-(Vpres / Vp) * Mat3::Identity(), xp, Vp);
+      }
       const std::int64_t o = p * K;
       for (int k = 0; k < K; ++k) {
         const int i = cache.node[o + k];
@@ -115,8 +122,10 @@ void particles_to_grid(const Body<G>& body, const ShapeCache<G::dim>& cache, Gri
           mv[i] += (w * mp) * vp;
         }
         f[i] -= Vsig * cache.grad[o + k];
+        if constexpr (G::has_hoop_terms) f[i] += w * f_point;
         if (split_pressure) {
           fp[i].template head<D>() += Vpres * cache.grad[o + k];
+          if constexpr (G::has_hoop_terms) fp[i] += w * fp_point;
           vol[i] += w * Vp;
         }
       }
@@ -185,6 +194,7 @@ void grid_to_particles(Body<G>& body, const ShapeCache<G::dim>& cache, const Gri
     Vec<NC> v_pic = Vec<NC>::Zero(), dv = Vec<NC>::Zero();
     Mat<NC, D> grad_v = Mat<NC, D>::Zero(), B = Mat<NC, D>::Zero();
     double n_p = 0.0, div_q = 0.0;
+    Vec<NC> q_p = Vec<NC>::Zero();
     const std::int64_t o = p * K;
     for (int k = 0; k < K; ++k) {
       const int i = cache.node[o + k];
@@ -193,6 +203,7 @@ void grid_to_particles(Body<G>& body, const ShapeCache<G::dim>& cache, const Gri
       if (porosity) {
         n_p += w * porosity[i];
         div_q += mixture_flux[i].template head<D>().dot(cache.grad[o + k]);
+        if constexpr (G::has_hoop_terms) q_p += w * mixture_flux[i];
       }
       v_pic += w * vi;
       grad_v += vi * cache.grad[o + k].transpose();
@@ -202,7 +213,8 @@ void grid_to_particles(Body<G>& body, const ShapeCache<G::dim>& cache, const Gri
         dv += w * (vi - field.velocity_old[i]);
       }
     }
-    Vec<D> x = body.x_m[p] + dt_s * v_pic.template head<D>();
+    const Vec<D> x_old = body.x_m[p];
+    Vec<D> x = x_old + dt_s * v_pic.template head<D>();
     grid.wrap(x);
     body.x_m[p] = x;
     if (apic) {
@@ -212,10 +224,12 @@ void grid_to_particles(Body<G>& body, const ShapeCache<G::dim>& cache, const Gri
       body.v_m_s[p] = alpha * (body.v_m_s[p] + dv) + (1.0 - alpha) * v_pic;
     }
     if (porosity) {
+      if constexpr (G::has_hoop_terms) div_q += G::div_extra(q_p, x_old);
       body.phi[p] = 1.0 - n_p;
       body.div_q_1_s[p] = div_q;
     }
-    const Mat3 L = G::velocity_gradient(grad_v, x, body.v_m_s[p]);
+    // L at the start-of-step position from the grid velocity field (hoop entries use Σ N v_i).
+    const Mat3 L = G::velocity_gradient(grad_v, x_old, v_pic);
     body.L_1_s[p] = L;
     body.volume_m3[p] *= std::exp(dt_s * L.trace());  // step 7: V ← V exp(Δt tr L)
   }
