@@ -51,6 +51,7 @@ struct Body {
   std::vector<Mat<NC, D>> C_1_s;    ///< APIC affine velocity matrix (ncomp × dim)
   std::vector<Mat3> L_1_s;          ///< 3×3 velocity gradient of the last step (geometry terms incl.)
   std::vector<Mat3> stress_Pa;      ///< Cauchy stress, positive in tension
+  std::vector<Vec<NC>> f_ext_N;     ///< external force on the point (surface loads), spread by N_ip
   // Mixture fields interpolated from the nodes in G2P (fluid phase of a mixture only):
   std::vector<double> phi;          ///< granular volume fraction 1 − n at the point
   std::vector<double> div_q_1_s;    ///< div of the mixture volume flux q (E27)
@@ -68,6 +69,7 @@ struct Body {
     C_1_s.push_back(Mat<NC, D>::Zero());
     L_1_s.push_back(Mat3::Zero());
     stress_Pa.push_back(Mat3::Zero());
+    f_ext_N.push_back(Vec<NC>::Zero());
     phi.push_back(0.0);
     div_q_1_s.push_back(0.0);
     if (law) law->resize(size());

@@ -58,8 +58,8 @@ struct GridField {
   int max_threads() const { return static_cast<int>(t_mass.size()) + 1; }
 };
 
-/// P2G (model.md §6 step 2): nodal mass, momentum (with the APIC affine term when `apic`), and
-/// internal force f_i = −∑_p V_p σ_p ∇N_ip. K = local nodes per point (support^dim).
+/// P2G (model.md §6 step 2): nodal mass, momentum (with the APIC affine term when `apic`),
+/// internal force f_i = −∑_p V_p σ_p ∇N_ip, and external point loads ∑_p N_ip f_ext,p. K = local nodes per point (support^dim).
 /// With `split_pressure` (the fluid phase) the stress is split as σ = τ − p 1 (p = −tr σ/3): the
 /// internal force gets only τ, the pressure part ∑ V_p p_p ∇N_ip goes to `pressure_force_N` for the
 /// buoyancy split (E28), and the nodal mixture volume ∑ N_ip V_p is accumulated.
@@ -105,10 +105,10 @@ void particles_to_grid(const Body<G>& body, const ShapeCache<G::dim>& cache, Gri
       }
       const Mat<NC, D> Vsig = Vp * sig.template topLeftCorner<NC, D>();
       // Axisymmetric: hoop and inertial terms, applied with weight N_ip (zero-cost otherwise).
-      Vec<NC> f_point = Vec<NC>::Zero(), fp_point = Vec<NC>::Zero();
+      Vec<NC> f_point = body.f_ext_N[p], fp_point = Vec<NC>::Zero();  // external point load
       if constexpr (G::has_hoop_terms) {
         const Vec<D>& xp = body.x_m[p];
-        f_point = G::hoop_force(sig, xp, Vp) + mp * G::inertial_acceleration(xp, vp);
+        f_point += G::hoop_force(sig, xp, Vp) + mp * G::inertial_acceleration(xp, vp);
         if (split_pressure) fp_point = G::hoop_force(-(Vpres / Vp) * Mat3::Identity(), xp, Vp);
       }
       const std::int64_t o = p * K;
@@ -122,7 +122,7 @@ void particles_to_grid(const Body<G>& body, const ShapeCache<G::dim>& cache, Gri
           mv[i] += (w * mp) * vp;
         }
         f[i] -= Vsig * cache.grad[o + k];
-        if constexpr (G::has_hoop_terms) f[i] += w * f_point;
+        f[i] += w * f_point;
         if (split_pressure) {
           fp[i].template head<D>() += Vpres * cache.grad[o + k];
           if constexpr (G::has_hoop_terms) fp[i] += w * fp_point;
