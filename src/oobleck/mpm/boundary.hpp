@@ -71,15 +71,19 @@ void reflection(const FaceCondition& c, int a, Vec<NC>& s, Vec<NC>& U) {
 /// (mirror = itself), depth j ≥ 1 the ghost node j layers outside (mirror = j layers inside).
 template <int D, class F>
 void for_face_layers(const Grid<D>& grid, int a, bool upper, F&& f) {
-  const int nn = grid.node_count();
+  // Visit only the slab of the face: depth 0 … kGhost along axis a, every node of the other axes.
   const int N = grid.cells[a], st = grid.stride(a);
-#pragma omp parallel for schedule(static)
-  for (int n = 0; n < nn; ++n) {
-    const int i = grid.logical_index(a, grid.unflatten(n)[a]);
-    const int depth = upper ? i - N : -i;
-    if (depth < 0) continue;
-    const int mirror_i = upper ? N - depth : depth;
-    f(n, n + (mirror_i - i) * st, depth);
+  const int layers = Grid<D>::kGhost + 1;
+  const int outer = grid.node_count() / (grid.nodes(a) * st);  // product of the slower axes
+#pragma omp parallel for schedule(static) collapse(2)
+  for (int o = 0; o < outer; ++o) {
+    for (int depth = 0; depth < layers; ++depth) {
+      const int i = upper ? N + depth : -depth;  // logical index of the layer
+      const int mirror_i = upper ? N - depth : depth;
+      const int s_i = grid.storage_index(a, i), s_m = grid.storage_index(a, mirror_i);
+      const int base = o * grid.nodes(a) * st;
+      for (int r = 0; r < st; ++r) f(base + s_i * st + r, base + s_m * st + r, depth);
+    }
   }
 }
 }  // namespace detail

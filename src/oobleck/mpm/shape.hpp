@@ -144,6 +144,8 @@ std::int64_t compute_shape_cache(const Grid<D>& grid, const Kernel& kernel, cons
   cache.reserve(np, K);
   cache.apic_by_gradient = Kernel::apic_by_gradient;
   const double h = grid.h_m, inv_h = 1.0 / h;
+  int stride[D];
+  for (int a = 0; a < D; ++a) stride[a] = grid.stride(a);
   std::int64_t bad = 0;
 #pragma omp parallel for schedule(static) reduction(+ : bad)
   for (std::int64_t p = 0; p < np; ++p) {
@@ -159,39 +161,51 @@ std::int64_t compute_shape_cache(const Grid<D>& grid, const Kernel& kernel, cons
         dw1[a][j] *= inv_h;
         off1[a][j] = (base + j - xi) * h;
         m2 += w1[a][j] * off1[a][j] * off1[a][j];
-        const int s = grid.storage_index(a, base + j);
-        if (s < 0) ok = false;
-        idx1[a][j] = s < 0 ? 0 : s * grid.stride(a);
+        const int st = grid.storage_index(a, base + j);
+        if (st < 0) ok = false;
+        idx1[a][j] = st < 0 ? 0 : st * stride[a];
       }
       cache.inv_D[p][a] = m2 > 0.0 ? 1.0 / m2 : 0.0;
     }
     if (!ok) ++bad;
     // Tensor product; local node k enumerates (j_0, …, j_{D−1}) with the last axis fastest.
     const std::int64_t o = p * K;
-    for (int k = 0; k < K; ++k) {
-      int rem = k, flat = 0;
-      double wk = 1.0;
-      int j[D];
-      for (int a = D - 1; a >= 0; --a) {
-        j[a] = rem % S;
-        rem /= S;
+    if constexpr (D == 2) {
+      int k = 0;
+      for (int j0 = 0; j0 < S; ++j0) {
+        for (int j1 = 0; j1 < S; ++j1, ++k) {
+          cache.node[o + k] = idx1[0][j0] + idx1[1][j1];
+          cache.w[o + k] = w1[0][j0] * w1[1][j1];
+          cache.grad[o + k] = Vec<D>(dw1[0][j0] * w1[1][j1], w1[0][j0] * dw1[1][j1]);
+          cache.offset[o + k] = Vec<D>(off1[0][j0], off1[1][j1]);
+        }
       }
-      Vec<D> g, off;
-      for (int a = 0; a < D; ++a) {
-        flat += idx1[a][j[a]];
-        wk *= w1[a][j[a]];
-        off[a] = off1[a][j[a]];
+    } else {
+      for (int k = 0; k < K; ++k) {
+        int rem = k, flat = 0;
+        double wk = 1.0;
+        int j[D];
+        for (int a = D - 1; a >= 0; --a) {
+          j[a] = rem % S;
+          rem /= S;
+        }
+        Vec<D> g, off;
+        for (int a = 0; a < D; ++a) {
+          flat += idx1[a][j[a]];
+          wk *= w1[a][j[a]];
+          off[a] = off1[a][j[a]];
+        }
+        for (int a = 0; a < D; ++a) {
+          double ga = dw1[a][j[a]];
+          for (int b = 0; b < D; ++b)
+            if (b != a) ga *= w1[b][j[b]];
+          g[a] = ga;
+        }
+        cache.node[o + k] = flat;
+        cache.w[o + k] = wk;
+        cache.grad[o + k] = g;
+        cache.offset[o + k] = off;
       }
-      for (int a = 0; a < D; ++a) {
-        double ga = dw1[a][j[a]];
-        for (int b = 0; b < D; ++b)
-          if (b != a) ga *= w1[b][j[b]];
-        g[a] = ga;
-      }
-      cache.node[o + k] = flat;
-      cache.w[o + k] = wk;
-      cache.grad[o + k] = g;
-      cache.offset[o + k] = off;
     }
   }
   return bad;

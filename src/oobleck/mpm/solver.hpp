@@ -67,6 +67,12 @@ inline int kernel_support(ShapeKind k) {
   }
 }
 
+/// Accumulated wall time [s] per part of the step (where the time goes).
+struct StepTimings {
+  double shape = 0, p2g = 0, grid = 0, g2p = 0, stress = 0;
+  double total() const { return shape + p2g + grid + g2p + stress; }
+};
+
 template <class G>
 class Solver {
  public:
@@ -135,8 +141,11 @@ class Solver {
   void step() {
     with_support([&](auto S) {
       constexpr int K = ipow(decltype(S)::value, D);
+      StepClock clock(timings_);
       compute_shape_functions();           // 1. N_ip, ∇N_ip cached per point
+      clock.lap(timings_.shape);
       particles_to_grid_all<K>();          // 2. mass, momentum, internal force
+      clock.lap(timings_.p2g);
       apply_body_loads();                  // 3. gravity (motors later)
       fold_wall_images_all();              // 4a. walls: ghost contributions onto mirrors
       apply_mixture_forces();              // 3a. porosity n_i, buoyancy split E28, ∇p_0
@@ -144,15 +153,32 @@ class Solver {
       apply_drag();                        // 3b. semi-implicit E29 drag (contact §8 later)
       apply_boundary_conditions_all();     // 4b. walls on nodal velocities, ghost images
       compute_mixture_flux();              //     q_i = (1−n_i) v^s_i + n_i v^f_i for E27
+      clock.lap(timings_.grid);
       grid_to_particles_all<K>();          // 6–7. x, v (FLIP/PIC or APIC), L, V ← V exp(Δt tr L)
+      clock.lap(timings_.g2p);
       update_stresses();                   // 8. laws
+      clock.lap(timings_.stress);
     });
     time_s_ += opt_.dt_s;
     ++steps_;
   }
 
+ /// Wall time per part of the step, accumulated since construction or reset_timings().
+  const StepTimings& timings() const { return timings_; }
+  void reset_timings() { timings_ = {}; }
+
  private:
   static constexpr int ipow(int b, int e) { return e == 0 ? 1 : b * ipow(b, e - 1); }
+
+  struct StepClock {
+    explicit StepClock(StepTimings&) : t0(omp_get_wtime()) {}
+    void lap(double& acc) {
+      const double t = omp_get_wtime();
+      acc += t - t0;
+      t0 = t;
+    }
+    double t0;
+  };
 
   template <class F>
   void with_support(F&& f) {
@@ -289,6 +315,7 @@ class Solver {
   std::vector<GridField<G>> fields_;
   int threads_ = 1;
   int grains_ = -1, fluid_ = -1;
+  StepTimings timings_;
   std::vector<double> porosity_;  ///< nodal porosity n_i of the mixture
   std::vector<Vec<NC>> flux_;     ///< nodal mixture volume flux q_i
   double time_s_ = 0.0;
