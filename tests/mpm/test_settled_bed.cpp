@@ -2,7 +2,8 @@
 // column of height H on a frictionless floor, periodic in x, with gravity. The analytic settled
 // state is p_f = ρ_f g (H − y) (fluid carries its own weight) and a granular effective stress
 // σ̃_yy = −φ (ρ_s − ρ_f) g (H − y) (the skeleton carries the buoyant weight, E28), σ̃_xx = σ̃_zz =
-// ν/(1−ν) σ̃_yy. Started there, the discrete two-phase system must hold it: velocities stay
+// ν/(1−ν) σ̃_yy, set by set_hydrostatic_bed (mpm/initial_state.hpp). Started there, the discrete
+// two-phase system must hold it: velocities stay
 // ≪ g T and the stresses at the floor stay at the analytic values. (The test checks that the
 // analytic state is an equilibrium of the discrete coupling — buoyancy split, porosity, pressure
 // force — not the transient that reaches it.)
@@ -10,6 +11,7 @@
 
 #include <cmath>
 
+#include "oobleck/mpm/initial_state.hpp"
 #include "oobleck/mpm/laws.hpp"
 #include "oobleck/mpm/solver.hpp"
 
@@ -41,24 +43,18 @@ TEST(SettledBedV4, HydrostaticFluidAndBuoyantWeightOnSkeleton) {
     fp.eta_0_Pa_s = 1e-3;
     fp.kappa_Pa = 1e6;
     fp.rho_f0_kg_m3 = rho_f;
-    auto fluid_law = std::make_unique<FluidLaw<PlaneStrain>>(fp, 0.01);
-    auto* fl = fluid_law.get();
-    fluid.set_law(std::move(fluid_law));
+    fluid.set_law(std::make_unique<FluidLaw<PlaneStrain>>(fp, 0.01));
     auto zero = [](const Vec<2>&) { return Vec<2>::Zero(); };
     fill_box(grains, Vec<2>(0, 0), Vec<2>(4 * h, H), h, 2, phi * rho_s, zero);
     fill_box(fluid, Vec<2>(0, 0), Vec<2>(4 * h, H), h, 2, (1.0 - phi) * rho_f, zero);
-    const double K0 = ep.poisson_ratio / (1.0 - ep.poisson_ratio);
-    for (std::int64_t p = 0; p < grains.size(); ++p) {
-      const double syy = -phi * (rho_s - rho_f) * g * (H - grains.x_m[p][1]);
-      grains.stress_Pa[p].diagonal() << K0 * syy, syy, K0 * syy;
-    }
-    for (std::int64_t p = 0; p < fluid.size(); ++p) {
-      const double pf = rho_f * g * (H - fluid.x_m[p][1]);
-      fl->J[p] = std::exp(-pf / fp.kappa_Pa);  // E26 inverted
-      fluid.mass_kg[p] /= fl->J[p];            // compressed fluid: ρ_f = ρ_f0/J
-      fluid.stress_Pa[p].diagonal().setConstant(-pf);
-      fluid.phi[p] = phi;
-    }
+    HydrostaticBed bed;
+    bed.surface_m = H;
+    bed.g_m_s2 = g;
+    bed.rho_s_kg_m3 = rho_s;
+    bed.rho_f0_kg_m3 = rho_f;
+    bed.K0 = ep.poisson_ratio / (1.0 - ep.poisson_ratio);  // uniaxial-strain elastic skeleton
+    bed.phi_bed = phi;
+    set_hydrostatic_bed(bed, &grains, &fluid);
     opt.dt_s = s.stable_dt(0.3);
     s.options().dt_s = opt.dt_s;
     const double c_skel = std::sqrt(ep.p_wave_modulus_Pa() / (phi * rho_s));
