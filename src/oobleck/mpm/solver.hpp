@@ -148,9 +148,9 @@ class Solver {
       clock.lap(timings_.p2g);
       apply_body_loads();                  // 3. gravity (motors later)
       fold_wall_images_all();              // 4a. walls: ghost contributions onto mirrors
-      apply_mixture_forces();              // 3a. porosity n_i, buoyancy split E28, ∇p_0
-      predict_grid_velocities();           // 5. v = (mv + Δt f)/m with all non-drag forces
-      apply_drag();                        // 3b. semi-implicit E29 drag (contact §8 later)
+      update_grid_and_couple();            // per node, fused: 3a. porosity n_i, buoyancy split
+                                           // E28, ∇p_0; 5. v = (mv + Δt f)/m with all non-drag
+                                           // forces; 3b. semi-implicit E29 drag
       apply_boundary_conditions_all();     // 4b. walls on nodal velocities, ghost images
       compute_mixture_flux();              //     q_i = (1−n_i) v^s_i + n_i v^f_i for E27
       clock.lap(timings_.grid);
@@ -212,12 +212,23 @@ class Solver {
 
   bool mixture() const { return grains_ >= 0 && fluid_ >= 0; }
 
-  /// Nodal porosity n_i = 1 − m^s_i/(ρ_s V_i) (clamped to [n_min, 1]; 1 where there are no grains),
-  /// then the pressure force ∑ V p ∇N split: grains (1 − n_i), fluid n_i (E28), and the same split
-  /// of a background gradient −V_i ∇p_0. The viscous τ_f already acts on the fluid alone.
-  /// Without a granular body (fluid only) n_i = 1 and the whole pressure force acts on the fluid.
-  void apply_mixture_forces() {
-    if (fluid_ < 0) return;
+  /// Grid update of every body, with the phase coupling for the mixture. All three parts are
+  /// node-local, so they run in one pass over the nodes:
+  ///  * nodal porosity n_i = 1 − m^s_i/(ρ_s V_i) (clamped to [n_min, 1]; 1 where there are no
+  ///    grains or no granular body), the pressure force ∑ V p ∇N split grains (1 − n_i), fluid n_i
+  ///    (E28), and the same split of a background gradient −V_i ∇p_0 (the viscous τ_f already acts
+  ///    on the fluid alone);
+  ///  * predicted velocities v = (mv + Δt f)/m;
+  ///  * semi-implicit drag (model.md §5): C_i = V_i C_V(φ_i, Re_i) with the predicted velocities,
+  ///    F_d = C_i/(1 + Δt C_i (1/m_s + 1/m_f)) Δv; grains −F_d, fluid +F_d.
+  void update_grid_and_couple() {
+    const double dt = opt_.dt_s;
+    for (int b = 0; b < body_count(); ++b)
+      if (b != grains_ && b != fluid_) update_grid_velocity(fields_[b], dt);
+    if (fluid_ < 0) {
+      if (grains_ >= 0) update_grid_velocity(fields_[grains_], dt);
+      return;
+    }
     GridField<G>& s = fields_[grains_ >= 0 ? grains_ : fluid_];
     GridField<G>& f = fields_[fluid_];
     const bool grains = grains_ >= 0;
@@ -226,31 +237,17 @@ class Solver {
     porosity_.resize(static_cast<std::size_t>(nn));
 #pragma omp parallel for schedule(static)
     for (int i = 0; i < nn; ++i) {
-      const double V = f.volume_m3[i];
+      const double V = f.volume_m3[i], ms = grains ? s.mass_kg[i] : 0.0, mf = f.mass_kg[i];
       double n = 1.0;
-      if (grains && V > 0.0 && s.mass_kg[i] > 0.0)
-        n = std::clamp(1.0 - s.mass_kg[i] / (mx.rho_s_kg_m3 * V), mx.min_porosity, 1.0);
+      if (V > 0.0 && ms > 0.0) n = std::clamp(1.0 - ms / (mx.rho_s_kg_m3 * V), mx.min_porosity, 1.0);
       porosity_[i] = n;
       const Vec<NC> Fp = f.pressure_force_N[i] - V * mx.background_pressure_gradient_Pa_m;
-      if (grains) s.force_N[i] += (1.0 - n) * Fp;
       f.force_N[i] += n * Fp;
-    }
-  }
-
-  /// Semi-implicit drag per node (model.md §5): C_i = V_i C_V(φ_i, Re_i) with the predicted
-  /// velocities, F_d = C_i/(1 + Δt C_i (1/m_s + 1/m_f)) Δv; grains −F_d, fluid +F_d.
-  void apply_drag() {
-    if (!mixture()) return;
-    GridField<G>& s = fields_[grains_];
-    GridField<G>& f = fields_[fluid_];
-    const auto& mx = opt_.mixture;
-    const double dt = opt_.dt_s;
-    const int nn = f.nodes();
-#pragma omp parallel for schedule(static)
-    for (int i = 0; i < nn; ++i) {
-      const double ms = s.mass_kg[i], mf = f.mass_kg[i], V = f.volume_m3[i];
+      predict_node(f, i, dt);
+      if (!grains) continue;
+      s.force_N[i] += (1.0 - n) * Fp;
+      predict_node(s, i, dt);
       if (!(ms > 0.0 && mf > 0.0 && V > 0.0)) continue;
-      const double n = porosity_[i];
       const Vec<NC> dv = s.velocity[i] - f.velocity[i];
       const double rho_f = mf / (n * V);
       const double Re = material::drag_reynolds(dv.norm(), n, rho_f, mx.drag.d_m, mx.drag.eta_0_Pa_s);
@@ -260,6 +257,17 @@ class Solver {
       f.velocity[i] += (dt / mf) * Fd;
       s.force_N[i] -= Fd;  // kept for output/diagnostics
       f.force_N[i] += Fd;
+    }
+  }
+
+  static void predict_node(GridField<G>& field, int i, double dt) {
+    const double m = field.mass_kg[i];
+    if (m > 0.0) {
+      field.velocity_old[i] = field.momentum[i] / m;
+      field.velocity[i] = (field.momentum[i] + dt * field.force_N[i]) / m;
+    } else {
+      field.velocity_old[i].setZero();
+      field.velocity[i].setZero();
     }
   }
 
@@ -283,10 +291,6 @@ class Solver {
 
   void fold_wall_images_all() {
     for (auto& f : fields_) fold_wall_images<G>(grid_, bc_, f);
-  }
-
-  void predict_grid_velocities() {
-    for (auto& f : fields_) update_grid_velocity(f, opt_.dt_s);
   }
 
   void apply_boundary_conditions_all() {
