@@ -109,3 +109,50 @@ TEST(SettlingV4, FiniteReynoldsAndCarmanKozeny) {
     EXPECT_NEAR(r.u_settle_m_s, r.u_exact_m_s, 1e-6 * r.u_exact_m_s);
   }
 }
+
+TEST(SettlingV4, AxisymmetricColumnSameVelocity) {
+  // The same balance in axisymmetric mode: a cylinder r ∈ [0, R] (axis + frictionless outer
+  // wall), periodic in z, gravity along −z. Masses and volumes are both per radian, so the nodal
+  // porosity n_i = 1 − m^s_i/(ρ_s V_i) is right (the pitfall of model.md §5).
+  const double phi = 0.3, rho_s = 1620.0, rho_f = 1000.0, g = 9.81, h = 1e-3, d = 5.85e-6, eta0 = 1e-3;
+  const int cells = 8;
+  Grid<2> grid(Vec<2>(0.0, 0.0), h, {cells, cells}, {false, true});
+  SolverOptions<Axisymmetric> opt;
+  opt.shape = ShapeKind::QuadraticBSpline;
+  opt.threads = 1;
+  opt.dt_s = 1e-5;
+  opt.gravity_m_s2 = Vec<3>(0.0, -g, 0.0);
+  opt.mixture.rho_s_kg_m3 = rho_s;
+  opt.mixture.rho_f0_kg_m3 = rho_f;
+  opt.mixture.drag.d_m = d;
+  opt.mixture.drag.eta_0_Pa_s = eta0;
+  opt.mixture.background_pressure_gradient_Pa_m = (phi * rho_s + (1.0 - phi) * rho_f) * opt.gravity_m_s2;
+  Solver<Axisymmetric> s(grid, opt);
+  s.boundaries()[0].type = WallType::Axis;
+  s.boundaries()[1].type = WallType::Slip;
+  auto& grains = s.add_body("grains", Phase::Grains);
+  auto& fluid = s.add_body("fluid", Phase::Fluid);
+  mat::FluidParams fp;
+  fp.eta_0_Pa_s = eta0;
+  fp.kappa_Pa = 1e6;
+  fp.rho_f0_kg_m3 = rho_f;
+  fluid.set_law(std::make_unique<FluidLaw<Axisymmetric>>(fp, opt.mixture.min_porosity));
+  auto zero = [](const Vec<2>&) { return Vec<3>::Zero(); };
+  fill_box(grains, Vec<2>(0, 0), Vec<2>(cells * h, cells * h), h, 2, phi * rho_s, zero);
+  fill_box(fluid, Vec<2>(0, 0), Vec<2>(cells * h, cells * h), h, 2, (1.0 - phi) * rho_f, zero);
+  for (int i = 0; i < 20; ++i) s.step();
+  mat::DragParams dp;
+  dp.d_m = d;
+  dp.eta_0_Pa_s = eta0;
+  double dv = 0.0;
+  for (int it = 0; it < 100; ++it)
+    dv = (rho_s - rho_f) * g * d * d / (18.0 * eta0 * mat::drag_F(dp, phi, mat::drag_reynolds(dv, 1.0 - phi, rho_f, d, eta0)));
+  const double u_exact = (1.0 - phi) * dv;
+  // Every point (not only the mean) settles at the balance velocity, also next to the axis/wall.
+  for (std::int64_t p = 0; p < grains.size(); ++p) {
+    const double vs = grains.v_m_s[p][1], vf = fluid.v_m_s[p][1];
+    const double j = phi * vs + (1.0 - phi) * vf;
+    EXPECT_NEAR(-(vs - j), u_exact, 1e-4 * u_exact) << "r " << grains.x_m[p][0];
+    EXPECT_NEAR(grains.v_m_s[p][0], 0.0, 1e-6 * u_exact);
+  }
+}
