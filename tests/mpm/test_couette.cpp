@@ -31,7 +31,10 @@ TEST(CouetteV3, PlanarSteadyProfileAndStress) {
     fill_box(f, Vec<2>(0.0, 0.0), Vec<2>(4 * h, H), h, 2, rho, [](const Vec<2>&) { return Vec<2>::Zero(); });
     const double dt_visc = rho * h * h / (2.0 * eta);
     EXPECT_NEAR(s.stable_dt(0.5), dt_visc, 1e-12 * dt_visc);  // 5e-4 s < 0.5 h/√(κ/ρ) = 7.1e-4 s
+    s.options().dt_s = 1.01 * dt_visc;
+    EXPECT_THROW(s.check_time_step(0.5), oobleck::InputError);  // refused with the numbers
     s.options().dt_s = 0.5 * s.stable_dt(0.5);
+    EXPECT_NO_THROW(s.check_time_step(0.5));
     const double t_end = 3.0 * H * H * rho / eta;  // ≈ 3 diffusion times: e^{−π² 3} ≈ 1e-13
     while (s.time_s() < t_end) s.step();
     for (std::int64_t p = 0; p < f.size(); ++p) {

@@ -6,9 +6,9 @@
 //   fill_box(b, lo, hi, h, ppc, rho, v0);  s.boundaries()[0] = {WallType::Slip};
 //   while (s.time_s() < T) s.step();
 //
-// Each body has its own grid field; the phase coupling (buoyancy split, semi-implicit drag,
-// model.md §5) and contact (§8) plug into `couple_bodies()` between the predicted grid velocities
-// and the boundary conditions.
+// Each body has its own grid field. The phase coupling (porosity, buoyancy split, semi-implicit
+// drag, model.md §5) runs in `update_grid_and_couple()` between the wall folding and the boundary
+// conditions; contact (§8) will plug in at the same place.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -34,7 +34,8 @@ namespace oobleck::mpm {
 /// Role of a body: a single-phase solid, or the granular or fluid phase of the mixture.
 enum class Phase { Solid, Grains, Fluid };
 
-/// Two-phase mixture parameters (model.md §5), used when a Grains and a Fluid body exist.
+/// Mixture parameters (model.md §5), used when a Fluid body exists (the drag and porosity only
+/// with a Grains body as well).
 template <class G>
 struct MixtureOptions {
   double rho_s_kg_m3 = 1620.0;     ///< grain true density ρ_s
@@ -55,7 +56,7 @@ struct SolverOptions {
   double flip_fraction = 0.99;                          ///< α of the FLIP/PIC blend
   Vec<G::ncomp> gravity_m_s2 = Vec<G::ncomp>::Zero();   ///< gravitational acceleration
   int threads = 0;                                      ///< OpenMP threads (0: omp default)
-  MixtureOptions<G> mixture;                            ///< used only with Grains + Fluid bodies
+  MixtureOptions<G> mixture;                            ///< used when a Fluid body exists
 };
 
 /// Number of nodes per axis in the support of a kernel.
@@ -137,6 +138,16 @@ class Solver {
     return std::min(c_max > 0.0 ? cfl * grid_.h_m / c_max : INFINITY, dt_visc);
   }
 
+  /// Refuse a time step above the stable one (model.md §6): throws InputError with the numbers.
+  void check_time_step(double cfl = 0.5) const {
+    const double dt_max = stable_dt(cfl);
+    if (opt_.dt_s > dt_max)
+      throw InputError(fmt::format(
+          "mpm: time step dt = {:.4g} s is above the stable limit {:.4g} s (CFL {} on the fastest "
+          "wave, viscous limit rho h^2/(2 eta), h = {:.4g} m)",
+          opt_.dt_s, dt_max, cfl, grid_.h_m));
+  }
+
   /// One explicit step of length options().dt_s.
   void step() {
     with_support([&](auto S) {
@@ -163,7 +174,7 @@ class Solver {
     ++steps_;
   }
 
- /// Wall time per part of the step, accumulated since construction or reset_timings().
+  /// Wall time per part of the step, accumulated since construction or reset_timings().
   const StepTimings& timings() const { return timings_; }
   void reset_timings() { timings_ = {}; }
 
