@@ -120,3 +120,38 @@ TEST(Boundary, PrescribedWallsCarryBlockRigidly) {
     }
   }
 }
+
+TEST(Boundary, CoulombFrictionFloorDeceleratesSlidingBlockAtMuG) {
+  // An elastic block in geostatic equilibrium on a frictional floor (μ = 0.3), periodic in x,
+  // sliding at v0: a rigid-body sliding on Coulomb friction decelerates at μ g until it stops.
+  for (ShapeKind k : {ShapeKind::QuadraticBSpline, ShapeKind::CubicBSpline}) {
+    const double H = 0.5, h = H / 8, rho = 1000.0, g = 9.81, mu = 0.3, v0 = 1.0;
+    LinearElasticParams ep;
+    ep.youngs_modulus_Pa = 1e7;
+    ep.poisson_ratio = 0.3;
+    const double c = std::sqrt(ep.p_wave_modulus_Pa() / rho);
+    Grid<2> grid(Vec<2>(0.0, 0.0), h, {4, 12}, {true, false});
+    SolverOptions<PlaneStrain> opt;
+    opt.shape = k;
+    opt.threads = 1;
+    opt.dt_s = 0.3 * h / c;
+    opt.gravity_m_s2 = Vec<2>(0.0, -g);
+    Solver<PlaneStrain> s(grid, opt);
+    s.boundaries()[2].type = WallType::Friction;
+    s.boundaries()[2].friction_coefficient = mu;
+    auto& b = s.add_body("block");
+    b.set_law(std::make_unique<LinearElasticLaw<PlaneStrain>>(ep));
+    fill_box(b, Vec<2>(0.0, 0.0), Vec<2>(4 * h, H), h, 2, rho, [&](const Vec<2>&) { return Vec<2>(v0, 0.0); });
+    const double K0 = ep.poisson_ratio / (1.0 - ep.poisson_ratio);
+    for (std::int64_t p = 0; p < b.size(); ++p) {
+      const double syy = -rho * g * (H - b.x_m[p][1]);
+      b.stress_Pa[p].diagonal() << K0 * syy, syy, K0 * syy;
+    }
+    const double t1 = 0.2;  // v(t1) = v0 − μ g t1 = 0.41 m/s
+    while (s.time_s() < t1) s.step();
+    const double v_mean = b.total_momentum()[0] / b.total_mass();
+    EXPECT_NEAR(v_mean, v0 - mu * g * s.time_s(), 0.005 * v0) << "kind " << static_cast<int>(k);
+    while (s.time_s() < 0.5) s.step();  // stopped at t = v0/(μ g) = 0.34 s, and stays
+    EXPECT_NEAR(b.total_momentum()[0] / b.total_mass(), 0.0, 0.02 * v0) << "kind " << static_cast<int>(k);
+  }
+}

@@ -23,6 +23,7 @@
 // reduces to the usual nodal condition. Faces are processed axis by axis, so corners get the
 // composition of the two reflections. An `Open` face imposes nothing (ghost nodes are plain nodes;
 // points may move at most one cell outside the domain).
+#include <algorithm>
 #include <array>
 
 #include "oobleck/mpm/geometry.hpp"
@@ -37,11 +38,14 @@ enum class WallType {
   Slip,        ///< frictionless, bilateral: normal component v_n = U_n (tangential free)
   Prescribed,  ///< every component v = U (moving wall, driven bob, …)
   Axis,        ///< symmetry axis r = 0 (axisymmetric): v_r = v_θ = 0, v_z free
+  Friction,    ///< bilateral normal as Slip, Coulomb friction |Δv_t| ≤ μ Δv_n on the tangential
+               ///< velocity relative to the wall (velocity_m_s), from the wall's normal impulse
 };
 
 struct FaceCondition {
   WallType type = WallType::Open;
   Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();  ///< wall velocity U (components ≥ ncomp ignored)
+  double friction_coefficient = 0.0;                       ///< μ of a Friction wall [-]
 };
 
 /// Face index: 2a for the lower face of axis a, 2a + 1 for the upper face.
@@ -58,7 +62,7 @@ void reflection(const FaceCondition& c, int a, Vec<NC>& s, Vec<NC>& U) {
     s.setConstant(1.0);
     s[a] = -1.0;
     if constexpr (NC > D) s[NC - 1] = -1.0;
-  } else if (c.type == WallType::Slip) {
+  } else if (c.type == WallType::Slip || c.type == WallType::Friction) {
     s.setConstant(1.0);
     s[a] = -1.0;
     U[a] = c.velocity_m_s[a];
@@ -109,6 +113,21 @@ void fold_wall_images(const Grid<G::dim>& grid, const BoundaryConditions<G::dim>
         const Vec<NC> f_img = s.cwiseProduct(f);
         const Vec<NC> fp_img = s.cwiseProduct(field.pressure_force_N[ghost]);
         const double V = field.volume_m3[ghost];
+        if (c.type == WallType::Friction) {
+          // Record the *real* (unfolded) normal momentum, force and mass of the node pair
+          // (mirror + its ghost; the wall node alone) along the inward normal; the wall's normal
+          // impulse follows after the grid update (apply_boundary_conditions).
+          const double n_in = side == 0 ? 1.0 : -1.0;
+          if (depth == 0) {
+            field.wall_normal_momentum[ghost] = n_in * p[a];
+            field.wall_normal_force[ghost] = n_in * f[a];
+            field.wall_mass_difference[ghost] = m;
+          } else {
+            field.wall_normal_momentum[mirror] = n_in * (field.momentum[mirror][a] + p[a]);
+            field.wall_normal_force[mirror] = n_in * (field.force_N[mirror][a] + f[a]);
+            field.wall_mass_difference[mirror] = field.mass_kg[mirror] - m;
+          }
+        }
         if (depth == 0) {
           field.mass_kg[ghost] = 2.0 * m;
           field.momentum[ghost] = p + p_img;
@@ -128,10 +147,15 @@ void fold_wall_images(const Grid<G::dim>& grid, const BoundaryConditions<G::dim>
 }
 
 /// Impose the wall conditions on the updated nodal velocities and set the ghost nodes' velocities
-/// to the reflections of their mirrors (see header).
+/// to the reflections of their mirrors (see header). Friction walls: at every node of the face
+/// layers, the normal impulse the wall gave the real mass of the node (and of its ghost, which
+/// moves with it), J_n = (m_node − m_ghost) v_n − (P_n + Δt F_n) from the unfolded real normal
+/// momentum P_n and force F_n recorded by fold_wall_images (effective stress and gravity; the
+/// pore-pressure split is not included, so friction follows the effective normal stress), limits
+/// the tangential slip: |v_t − U_t| ← max(0, |v_t − U_t| − μ J_n/m_real) when J_n > 0.
 template <class G>
 void apply_boundary_conditions(const Grid<G::dim>& grid, const BoundaryConditions<G::dim>& bc,
-                               GridField<G>& field) {
+                               GridField<G>& field, double dt_s = 0.0) {
   constexpr int D = G::dim, NC = G::ncomp;
   for (int a = 0; a < D; ++a) {
     if (grid.periodic[a]) continue;
@@ -151,6 +175,27 @@ void apply_boundary_conditions(const Grid<G::dim>& grid, const BoundaryCondition
           }
         }
       });
+      if (c.type == WallType::Friction) {
+        const double mu = c.friction_coefficient;
+        detail::for_face_layers(grid, a, side == 1, [&](int node, int mirror, int depth) {
+          const int t = depth == 0 ? node : mirror;
+          const double n_in = side == 0 ? 1.0 : -1.0;
+          const double Jn = field.wall_mass_difference[t] * n_in * field.velocity[t][a] -
+                            (field.wall_normal_momentum[t] + dt_s * field.wall_normal_force[t]);
+          // Real mass that feels this node's tangential change: the wall node carries its own
+          // image (half of its folded mass); a mirror node's velocity is also its ghost's, so its
+          // whole folded mass is real.
+          const double m = depth == 0 ? 0.5 * field.mass_kg[t] : field.mass_kg[t];
+          if (!(Jn > 0.0 && m > 0.0)) return;
+          Vec<NC> vt = Vec<NC>::Zero();
+          for (int k = 0; k < NC; ++k)
+            if (k != a) vt[k] = field.velocity[t][k] - c.velocity_m_s[k];
+          const double speed = vt.norm();
+          if (speed <= 0.0) return;
+          const double scale = std::max(0.0, 1.0 - mu * Jn / (m * speed));
+          field.velocity[t] -= (1.0 - scale) * vt;
+        });
+      }
       detail::for_face_layers(grid, a, side == 1, [&](int ghost, int mirror, int depth) {
         if (depth == 0) return;
         field.velocity[ghost] = s.cwiseProduct(field.velocity[mirror]) + one_minus_s.cwiseProduct(U);

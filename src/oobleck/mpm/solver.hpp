@@ -305,7 +305,7 @@ class Solver {
   }
 
   void apply_boundary_conditions_all() {
-    for (auto& f : fields_) apply_boundary_conditions<G>(grid_, bc_, f);
+    for (auto& f : fields_) apply_boundary_conditions<G>(grid_, bc_, f, opt_.dt_s);
   }
 
   template <int K>

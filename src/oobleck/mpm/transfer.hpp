@@ -34,6 +34,9 @@ struct GridField {
   // and the nodal mixture volume ∑_p N_ip V_p [m^D].
   std::vector<Vec<NC>> pressure_force_N;
   std::vector<double> volume_m3;
+  // Friction walls: real normal momentum [kg m/s], force [N] and mass difference [kg] of the
+  // wall-layer node pairs, recorded when folding (boundary.hpp).
+  std::vector<double> wall_normal_momentum, wall_normal_force, wall_mass_difference;
   // Per-thread scatter copies for threads 1 … T−1 (thread 0 writes into the arrays above).
   std::vector<std::vector<double>> t_mass, t_volume;
   std::vector<std::vector<Vec<NC>>> t_momentum, t_force, t_pressure;
@@ -47,6 +50,9 @@ struct GridField {
     velocity.assign(n, Vec<NC>::Zero());
     pressure_force_N.assign(n, Vec<NC>::Zero());
     volume_m3.assign(n, 0.0);
+    wall_normal_momentum.assign(n, 0.0);
+    wall_normal_force.assign(n, 0.0);
+    wall_mass_difference.assign(n, 0.0);
     const auto extra = static_cast<std::size_t>(threads > 1 ? threads - 1 : 0);
     t_mass.assign(extra, std::vector<double>(n, 0.0));
     t_momentum.assign(extra, std::vector<Vec<NC>>(n, Vec<NC>::Zero()));
