@@ -1,0 +1,66 @@
+#pragma once
+// Fluid phase law (model.md §4, E25–E27) as pure per-point functions. They know nothing of
+// grids or bodies: the MPM solver and any point driver call them with a point's state.
+//
+//   E25  τ_f = η_0 (1 + (5/2) φ) (∇v_f + ∇v_fᵀ − (2/3) div v_f 1)   (Einstein-corrected viscosity)
+//   E26  p_f = κ ln(ρ_f/ρ_f0) = −κ ln J,   J = ρ_f0/ρ_f
+//   E27  (n/ρ_f) Dρ_f/Dt = −div q,  q = (1−n) v_s + n v_f  ⇒  J ← J exp(Δt div q / n)
+//
+// Stress is positive in tension; p_f is positive in compression. Tensors are 3×3 in every
+// geometry mode (plane strain: zero third row/column of L; axisymmetric: (r, z, θ) order).
+#include <Eigen/Core>
+#include <cmath>
+
+namespace oobleck::material {
+
+/// Parameters of the fluid law, SI units.
+struct FluidParams {
+  double eta_0_Pa_s = 1e-3;       ///< [Pa s] fluid viscosity η_0
+  double kappa_Pa = 1e6;          ///< [Pa] fluid bulk modulus κ (E26; not given by the paper)
+  double rho_f0_kg_m3 = 1000.0;   ///< [kg/m^3] fluid rest density ρ_f0
+};
+
+/// Effective mixture viscosity seen by the fluid phase, η_0 (1 + 5φ/2) [Pa s] (E25).
+inline double fluid_effective_viscosity(double eta_0_Pa_s, double phi) {
+  return eta_0_Pa_s * (1.0 + 2.5 * phi);
+}
+
+/// E25: deviatoric viscous stress τ_f [Pa] from the fluid velocity gradient L = ∇v_f [1/s]
+/// (L_ij = ∂v_i/∂x_j) at granular volume fraction φ.
+inline Eigen::Matrix3d fluid_viscous_stress(const Eigen::Matrix3d& L, double phi, double eta_0_Pa_s) {
+  const double eta = fluid_effective_viscosity(eta_0_Pa_s, phi);
+  const double div = L.trace();
+  Eigen::Matrix3d tau = eta * (L + L.transpose());
+  tau.diagonal().array() -= eta * (2.0 / 3.0) * div;
+  return tau;
+}
+
+/// E26: fluid pressure p_f [Pa] from the volume ratio J = ρ_f0/ρ_f: p_f = κ ln(ρ_f/ρ_f0) = −κ ln J.
+inline double fluid_pressure(double J, double kappa_Pa) { return -kappa_Pa * std::log(J); }
+
+/// E26 written with densities.
+inline double fluid_pressure_from_density(double rho_f, double rho_f0, double kappa_Pa) {
+  return kappa_Pa * std::log(rho_f / rho_f0);
+}
+
+/// E27, integrated exponentially over one step with div q and n frozen:
+/// J ← J exp(Δt div q / n), q = (1−n) v_s + n v_f evaluated at the nodes and interpolated.
+/// `porosity` n must be > 0 (the solver clamps it with a named minimum, model.md §5).
+inline double update_fluid_volume_ratio(double J, double div_q_per_s, double porosity, double dt_s) {
+  return J * std::exp(dt_s * div_q_per_s / porosity);
+}
+
+/// Fluid Cauchy stress σ_f = τ_f − p_f 1 [Pa] (E25 + E26); `J` = ρ_f0/ρ_f.
+inline Eigen::Matrix3d fluid_cauchy_stress(const Eigen::Matrix3d& L, double phi, double J,
+                                           const FluidParams& p) {
+  Eigen::Matrix3d s = fluid_viscous_stress(L, phi, p.eta_0_Pa_s);
+  s.diagonal().array() -= fluid_pressure(J, p.kappa_Pa);
+  return s;
+}
+
+/// Fluid pressure-wave speed √(κ/ρ_f) [m/s] used by the stable time step (model.md §6).
+inline double fluid_wave_speed(double kappa_Pa, double rho_f_kg_m3) {
+  return std::sqrt(kappa_Pa / rho_f_kg_m3);
+}
+
+}  // namespace oobleck::material

@@ -1,0 +1,131 @@
+#pragma once
+// A body of material points in structure-of-arrays form, and the interface through which a
+// constitutive law plugs in.
+//
+// Each field is one contiguous array over the points. Per-law state (e.g. f and φ of the granular
+// phase, J of the fluid) lives in the law object attached to the body, again one array per
+// variable; the law updates the body's stress from the body's velocity gradient once per step.
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "oobleck/mpm/geometry.hpp"
+
+namespace oobleck::mpm {
+
+template <class G>
+struct Body;
+
+/// A stress law for a whole body (one virtual call per body per step; the loop over points and the
+/// per-point pure function are inside). Implementations own their per-point state arrays.
+template <class G>
+class StressLaw {
+ public:
+  virtual ~StressLaw() = default;
+  /// Called whenever points are added, so the law can size its state (new points get defaults).
+  virtual void resize(std::int64_t n_points) = 0;
+  /// Update body.stress from body.L (and the law's state) over one step of length dt [s].
+  virtual void update_stress(Body<G>& body, double dt_s) = 0;
+  /// Fastest wave speed [m/s] at the current state (for the stable time step, model.md §6).
+  virtual double max_wave_speed(const Body<G>& body) const = 0;
+  /// Largest stable Δt [s] of the law's own diffusion on a grid of cell size h (viscous limit
+  /// ρ h²/(2η), model.md §6); +∞ for laws without one.
+  virtual double viscous_dt_limit(const Body<G>& /*body*/, double /*h_m*/) const { return INFINITY; }
+  /// Short name for messages.
+  virtual const char* name() const = 0;
+};
+
+template <class G>
+struct Body {
+  static constexpr int D = G::dim;
+  static constexpr int NC = G::ncomp;
+
+  std::string name;
+  std::vector<double> mass_kg;      ///< point mass (per radian in axisymmetric mode)
+  std::vector<double> volume_m3;    ///< current point volume V_p
+  std::vector<double> volume0_m3;   ///< initial point volume
+  std::vector<Vec<D>> x_m;          ///< position
+  std::vector<Vec<NC>> v_m_s;       ///< velocity
+  std::vector<Mat<NC, D>> C_1_s;    ///< APIC affine velocity matrix (ncomp × dim)
+  std::vector<Mat3> L_1_s;          ///< 3×3 velocity gradient of the last step (geometry terms incl.)
+  std::vector<Mat3> stress_Pa;      ///< Cauchy stress, positive in tension
+  std::vector<Vec<NC>> f_ext_N;     ///< external force on the point (surface loads), spread by N_ip
+  // Mixture fields interpolated from the nodes in G2P (fluid phase of a mixture only):
+  std::vector<double> phi;          ///< granular volume fraction 1 − n at the point
+  std::vector<double> div_q_1_s;    ///< div of the mixture volume flux q (E27)
+  std::unique_ptr<StressLaw<G>> law;
+
+  std::int64_t size() const { return static_cast<std::int64_t>(mass_kg.size()); }
+
+  /// Append one point at rest-state stress zero.
+  void add_point(const Vec<D>& x, double volume, double density_kg_m3, const Vec<NC>& v = Vec<NC>::Zero()) {
+    mass_kg.push_back(volume * density_kg_m3);
+    volume_m3.push_back(volume);
+    volume0_m3.push_back(volume);
+    x_m.push_back(x);
+    v_m_s.push_back(v);
+    C_1_s.push_back(Mat<NC, D>::Zero());
+    L_1_s.push_back(Mat3::Zero());
+    stress_Pa.push_back(Mat3::Zero());
+    f_ext_N.push_back(Vec<NC>::Zero());
+    phi.push_back(0.0);
+    div_q_1_s.push_back(0.0);
+    if (law) law->resize(size());
+  }
+
+  void set_law(std::unique_ptr<StressLaw<G>> l) {
+    law = std::move(l);
+    if (law) law->resize(size());
+  }
+
+  /// Total mass [kg].
+  double total_mass() const {
+    double m = 0.0;
+    for (double mp : mass_kg) m += mp;
+    return m;
+  }
+  /// Total linear momentum [kg m/s] (point velocities).
+  Vec<NC> total_momentum() const {
+    Vec<NC> P = Vec<NC>::Zero();
+    for (std::int64_t p = 0; p < size(); ++p) P += mass_kg[p] * v_m_s[p];
+    return P;
+  }
+  /// Kinetic energy [J] of the point velocities.
+  double kinetic_energy() const {
+    double e = 0.0;
+    for (std::int64_t p = 0; p < size(); ++p) e += 0.5 * mass_kg[p] * v_m_s[p].squaredNorm();
+    return e;
+  }
+};
+
+/// Fill a box [lo, hi] with points on a regular lattice of `ppc` points per cell per axis
+/// (cell size h), all of density ρ, velocity from v(x). Point volume from the geometry's measure
+/// (per radian, A r, in axisymmetric mode).
+template <class G, class VFun>
+void fill_box(Body<G>& body, const Vec<G::dim>& lo, const Vec<G::dim>& hi, double h_m, int ppc,
+              double density_kg_m3, VFun&& velocity) {
+  constexpr int D = G::dim;
+  const double dx = h_m / ppc;
+  int n[D];
+  std::int64_t total = 1;
+  for (int a = 0; a < D; ++a) {
+    n[a] = static_cast<int>(std::lround((hi[a] - lo[a]) / dx));
+    total *= n[a];
+  }
+  double vol = 1.0;
+  for (int a = 0; a < D; ++a) vol *= dx;
+  for (std::int64_t q = 0; q < total; ++q) {
+    std::int64_t rem = q;
+    Vec<D> x;
+    for (int a = D - 1; a >= 0; --a) {
+      const auto i = rem % n[a];
+      rem /= n[a];
+      x[a] = lo[a] + (static_cast<double>(i) + 0.5) * dx;
+    }
+    body.add_point(x, G::measure(x, vol), density_kg_m3, velocity(x));
+  }
+}
+
+}  // namespace oobleck::mpm

@@ -1,0 +1,82 @@
+#pragma once
+// Geometry policies and small fixed-size types of the MPM solver (model.md §7).
+//
+// A geometry policy says how many spatial dimensions the grid has (`dim`) and how many velocity
+// components a point carries (`ncomp`), and supplies the geometry-specific pieces of the step:
+//   velocity_gradient(∑ v_i ∇N_ipᵀ, x_p, v_p)  the 3×3 L (hoop entries in axisymmetric mode),
+//   measure(x, area)                          point volume from its cross-section (per radian: A r),
+//   and, when has_hoop_terms, the per-point nodal force terms scaled by N_ip:
+//   hoop_force(σ, x, V) and inertial_acceleration(x, v) (centrifugal / Coriolis), and the extra
+//   divergence term div_extra(q, x) = q_r/r.
+// Plane strain (dim = ncomp = 2), 3D (dim = ncomp = 3) and axisymmetric with swirl (dim = 2,
+// ncomp = 3, components (r, z, θ)) are implemented.
+#include <Eigen/Core>
+
+namespace oobleck::mpm {
+
+template <int N>
+using Vec = Eigen::Matrix<double, N, 1>;
+template <int R, int C>
+using Mat = Eigen::Matrix<double, R, C>;
+using Mat3 = Eigen::Matrix3d;
+
+/// Plane strain: (x, y) grid, velocity (v_x, v_y); the out-of-plane strain rate is zero, so the
+/// 3×3 velocity gradient has a zero third row and column (σ_zz still evolves in the laws).
+struct PlaneStrain {
+  static constexpr int dim = 2;
+  static constexpr int ncomp = 2;
+  static constexpr const char* name = "plane_strain";
+  static constexpr bool has_hoop_terms = false;
+  static double measure(const Vec<dim>& /*x*/, double area) { return area; }
+  /// 3×3 velocity gradient L [1/s] from Σ_i v_i ∇N_ipᵀ (ncomp × dim).
+  static Mat3 velocity_gradient(const Mat<ncomp, dim>& grad_v, const Vec<dim>& /*x*/,
+                                const Vec<ncomp>& /*v*/) {
+    Mat3 L = Mat3::Zero();
+    L.topLeftCorner<2, 2>() = grad_v;
+    return L;
+  }
+};
+
+/// Full 3D: (x, y, z) grid and velocity.
+struct ThreeD {
+  static constexpr int dim = 3;
+  static constexpr int ncomp = 3;
+  static constexpr const char* name = "3d";
+  static constexpr bool has_hoop_terms = false;
+  static double measure(const Vec<dim>& /*x*/, double volume) { return volume; }
+  static Mat3 velocity_gradient(const Mat<ncomp, dim>& grad_v, const Vec<dim>& /*x*/,
+                                const Vec<ncomp>& /*v*/) {
+    return grad_v;
+  }
+};
+
+/// Axisymmetric with swirl (model.md §7): grid (r, z), velocity and 3×3 tensors in (r, z, θ)
+/// order. Masses and volumes are per radian (m = ρ A r, V = A r). The weak form per radian gives,
+/// per point and scaled by N_ip (dV = r dr dz):
+///   f_r −= σ_θθ V/r,  f_θ += σ_rθ V/r                         (hoop terms)
+///   f_r += m v_θ²/r,  f_θ −= m v_r v_θ/r                       (centrifugal, Coriolis: the physical
+///                                                                components' inertial terms)
+/// and L_θθ = v_r/r, L_rθ = −v_θ/r, div q = ∂q_r/∂r + ∂q_z/∂z + q_r/r.
+struct Axisymmetric {
+  static constexpr int dim = 2;
+  static constexpr int ncomp = 3;
+  static constexpr const char* name = "axisymmetric";
+  static constexpr bool has_hoop_terms = true;
+  static double measure(const Vec<dim>& x, double area) { return area * x[0]; }
+  static Mat3 velocity_gradient(const Mat<ncomp, dim>& grad_v, const Vec<dim>& x, const Vec<ncomp>& v) {
+    Mat3 L = Mat3::Zero();
+    L.leftCols<2>() = grad_v;
+    L(0, 2) = -v[2] / x[0];
+    L(2, 2) = v[0] / x[0];
+    return L;
+  }
+  static Vec<ncomp> hoop_force(const Mat3& sigma, const Vec<dim>& x, double V) {
+    return Vec<ncomp>(-sigma(2, 2) * V / x[0], 0.0, sigma(0, 2) * V / x[0]);
+  }
+  static Vec<ncomp> inertial_acceleration(const Vec<dim>& x, const Vec<ncomp>& v) {
+    return Vec<ncomp>(v[2] * v[2] / x[0], 0.0, -v[0] * v[2] / x[0]);
+  }
+  static double div_extra(const Vec<ncomp>& q, const Vec<dim>& x) { return q[0] / x[0]; }
+};
+
+}  // namespace oobleck::mpm

@@ -1,0 +1,340 @@
+#pragma once
+// The explicit MPM step (model.md §6, update-stress-last) for any number of bodies on one grid.
+//
+//   Solver<PlaneStrain> s(grid, options);
+//   auto& b = s.add_body("bar");  b.set_law(std::make_unique<LinearElasticLaw<PlaneStrain>>(p));
+//   fill_box(b, lo, hi, h, ppc, rho, v0);  s.boundaries()[0] = {WallType::Slip};
+//   while (s.time_s() < T) s.step();
+//
+// Each body has its own grid field. The phase coupling (porosity, buoyancy split, semi-implicit
+// drag, model.md §5) runs in `update_grid_and_couple()` between the wall folding and the boundary
+// conditions; contact (§8) will plug in at the same place.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <omp.h>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "oobleck/core/error.hpp"
+#include "oobleck/material/drag.hpp"
+#include "oobleck/mpm/body.hpp"
+#include "oobleck/mpm/boundary.hpp"
+#include "oobleck/mpm/grid.hpp"
+#include "oobleck/mpm/shape.hpp"
+#include "oobleck/mpm/transfer.hpp"
+
+namespace oobleck::mpm {
+
+/// Role of a body: a single-phase solid, or the granular or fluid phase of the mixture.
+enum class Phase { Solid, Grains, Fluid };
+
+/// Mixture parameters (model.md §5), used when a Fluid body exists (the drag and porosity only
+/// with a Grains body as well).
+template <class G>
+struct MixtureOptions {
+  double rho_s_kg_m3 = 1620.0;     ///< grain true density ρ_s
+  double rho_f0_kg_m3 = 1000.0;    ///< fluid rest density ρ_f0 (Re uses the nodal ρ_f)
+  double min_porosity = 0.01;      ///< lower clamp of the nodal porosity n_i [base]
+  material::DragParams drag;       ///< E29 (d, η_0, law)
+  /// Imposed uniform background pressure gradient ∇p_0 [Pa/m], split like the fluid pressure
+  /// (grains (1−n), fluid n). Periodic boxes use ∇p_0 = ρ_mix g to carry the mixture's weight.
+  Vec<G::ncomp> background_pressure_gradient_Pa_m = Vec<G::ncomp>::Zero();
+};
+
+template <class G>
+struct SolverOptions {
+  double dt_s = 1e-5;                                   ///< time step [s]
+  ShapeKind shape = ShapeKind::QuadraticBSpline;        ///< shape functions
+  double gimp_half_width_cells = 0.25;                  ///< uGIMP ℓ in cells (= 1/(2 ppc))
+  Transfer transfer = Transfer::Apic;                   ///< velocity transfer
+  double flip_fraction = 0.99;                          ///< α of the FLIP/PIC blend
+  Vec<G::ncomp> gravity_m_s2 = Vec<G::ncomp>::Zero();   ///< gravitational acceleration
+  int threads = 0;                                      ///< OpenMP threads (0: omp default)
+  MixtureOptions<G> mixture;                            ///< used when a Fluid body exists
+};
+
+/// Number of nodes per axis in the support of a kernel.
+inline int kernel_support(ShapeKind k) {
+  switch (k) {
+    case ShapeKind::Linear: return 2;
+    case ShapeKind::CubicBSpline: return 4;
+    default: return 3;
+  }
+}
+
+/// Accumulated wall time [s] per part of the step (where the time goes).
+struct StepTimings {
+  double shape = 0, p2g = 0, grid = 0, g2p = 0, stress = 0;
+  double total() const { return shape + p2g + grid + g2p + stress; }
+};
+
+template <class G>
+class Solver {
+ public:
+  static constexpr int D = G::dim;
+  static constexpr int NC = G::ncomp;
+
+  Solver(const Grid<D>& grid, const SolverOptions<G>& options) : grid_(grid), opt_(options) {
+    if (!(opt_.dt_s > 0.0)) throw InputError(fmt::format("mpm: dt must be > 0 s, got {}", opt_.dt_s));
+    if (!(opt_.flip_fraction >= 0.0 && opt_.flip_fraction <= 1.0))
+      throw InputError(fmt::format("mpm: flip_fraction must be in [0, 1], got {}", opt_.flip_fraction));
+    if (opt_.shape == ShapeKind::UGimp &&
+        !(opt_.gimp_half_width_cells > 0.0 && opt_.gimp_half_width_cells <= 0.5))
+      throw InputError(fmt::format("mpm: uGIMP half width must be in (0, 0.5] cells, got {}",
+                                   opt_.gimp_half_width_cells));
+    threads_ = opt_.threads > 0 ? opt_.threads : omp_get_max_threads();
+  }
+
+  /// Add a body. At most one Grains and one Fluid body (they are coupled at the nodes).
+  Body<G>& add_body(const std::string& name, Phase phase = Phase::Solid) {
+    const int index = static_cast<int>(bodies_.size());
+    if (phase == Phase::Grains) {
+      if (grains_ >= 0) throw InputError("mpm: only one granular body per solver");
+      grains_ = index;
+    }
+    if (phase == Phase::Fluid) {
+      if (fluid_ >= 0) throw InputError("mpm: only one fluid body per solver");
+      fluid_ = index;
+    }
+    bodies_.push_back(std::make_unique<Body<G>>());
+    bodies_.back()->name = name;
+    caches_.emplace_back();
+    fields_.emplace_back();
+    fields_.back().resize(grid_.node_count(), threads_);
+    return *bodies_.back();
+  }
+
+  BoundaryConditions<D>& boundaries() { return bc_; }
+  const Grid<D>& grid() const { return grid_; }
+  SolverOptions<G>& options() { return opt_; }
+  int body_count() const { return static_cast<int>(bodies_.size()); }
+  Body<G>& body(int b) { return *bodies_[b]; }
+  const GridField<G>& field(int b) const { return fields_[b]; }
+  const ShapeCache<D>& shape_cache(int b) const { return caches_[b]; }
+  double time_s() const { return time_s_; }
+  /// Nodal porosity of the last step (mixture only; empty otherwise).
+  const std::vector<double>& nodal_porosity() const { return porosity_; }
+  std::int64_t steps() const { return steps_; }
+  int threads() const { return threads_; }
+
+  /// Largest stable Δt [s]: the CFL condition on the fastest wave of every body
+  /// (Δt ≤ cfl h / (c + |v|_max)) and the laws' viscous limits ρ h²/(2η) (model.md §6). The
+  /// drag is semi-implicit and never limits Δt.
+  double stable_dt(double cfl = 0.5) const {
+    double c_max = 0.0, dt_visc = INFINITY;
+    for (const auto& b : bodies_) {
+      double c = b->law ? b->law->max_wave_speed(*b) : 0.0;
+      double vmax = 0.0;
+      for (const auto& v : b->v_m_s) vmax = std::max(vmax, v.norm());
+      c_max = std::max(c_max, c + vmax);
+      if (b->law) dt_visc = std::min(dt_visc, b->law->viscous_dt_limit(*b, grid_.h_m));
+    }
+    return std::min(c_max > 0.0 ? cfl * grid_.h_m / c_max : INFINITY, dt_visc);
+  }
+
+  /// Refuse a time step above the stable one (model.md §6): throws InputError with the numbers.
+  void check_time_step(double cfl = 0.5) const {
+    const double dt_max = stable_dt(cfl);
+    if (opt_.dt_s > dt_max)
+      throw InputError(fmt::format(
+          "mpm: time step dt = {:.4g} s is above the stable limit {:.4g} s (CFL {} on the fastest "
+          "wave, viscous limit rho h^2/(2 eta), h = {:.4g} m)",
+          opt_.dt_s, dt_max, cfl, grid_.h_m));
+  }
+
+  /// One explicit step of length options().dt_s.
+  void step() {
+    with_support([&](auto S) {
+      constexpr int K = ipow(decltype(S)::value, D);
+      StepClock clock(timings_);
+      compute_shape_functions();           // 1. N_ip, ∇N_ip cached per point
+      clock.lap(timings_.shape);
+      particles_to_grid_all<K>();          // 2. mass, momentum, internal force
+      clock.lap(timings_.p2g);
+      apply_body_loads();                  // 3. gravity (motors later)
+      fold_wall_images_all();              // 4a. walls: ghost contributions onto mirrors
+      update_grid_and_couple();            // per node, fused: 3a. porosity n_i, buoyancy split
+                                           // E28, ∇p_0; 5. v = (mv + Δt f)/m with all non-drag
+                                           // forces; 3b. semi-implicit E29 drag
+      apply_boundary_conditions_all();     // 4b. walls on nodal velocities, ghost images
+      compute_mixture_flux();              //     q_i = (1−n_i) v^s_i + n_i v^f_i for E27
+      clock.lap(timings_.grid);
+      grid_to_particles_all<K>();          // 6–7. x, v (FLIP/PIC or APIC), L, V ← V exp(Δt tr L)
+      clock.lap(timings_.g2p);
+      update_stresses();                   // 8. laws
+      clock.lap(timings_.stress);
+    });
+    time_s_ += opt_.dt_s;
+    ++steps_;
+  }
+
+  /// Wall time per part of the step, accumulated since construction or reset_timings().
+  const StepTimings& timings() const { return timings_; }
+  void reset_timings() { timings_ = {}; }
+
+ private:
+  static constexpr int ipow(int b, int e) { return e == 0 ? 1 : b * ipow(b, e - 1); }
+
+  struct StepClock {
+    explicit StepClock(StepTimings&) : t0(omp_get_wtime()) {}
+    void lap(double& acc) {
+      const double t = omp_get_wtime();
+      acc += t - t0;
+      t0 = t;
+    }
+    double t0;
+  };
+
+  template <class F>
+  void with_support(F&& f) {
+    switch (kernel_support(opt_.shape)) {
+      case 2: f(std::integral_constant<int, 2>{}); break;
+      case 4: f(std::integral_constant<int, 4>{}); break;
+      default: f(std::integral_constant<int, 3>{}); break;
+    }
+  }
+
+  void compute_shape_functions() {
+    omp_set_num_threads(threads_);
+    for (std::size_t b = 0; b < bodies_.size(); ++b) {
+      const std::int64_t bad = with_kernel(opt_.shape, opt_.gimp_half_width_cells, [&](auto kernel) {
+        return compute_shape_cache(grid_, kernel, bodies_[b]->x_m, caches_[b]);
+      });
+      if (bad > 0)
+        throw NumericalError(fmt::format(
+            "mpm: {} point(s) of body '{}' left the grid (more than one cell outside the domain) at "
+            "step {}, t = {} s",
+            bad, bodies_[b]->name, steps_, time_s_));
+    }
+  }
+
+  template <int K>
+  void particles_to_grid_all() {
+    const bool apic = opt_.transfer == Transfer::Apic;
+    for (std::size_t b = 0; b < bodies_.size(); ++b)
+      particles_to_grid<G, K>(*bodies_[b], caches_[b], fields_[b], apic, static_cast<int>(b) == fluid_);
+  }
+
+  bool mixture() const { return grains_ >= 0 && fluid_ >= 0; }
+
+  /// Grid update of every body, with the phase coupling for the mixture. All three parts are
+  /// node-local, so they run in one pass over the nodes:
+  ///  * nodal porosity n_i = 1 − m^s_i/(ρ_s V_i) (clamped to [n_min, 1]; 1 where there are no
+  ///    grains or no granular body), the pressure force ∑ V p ∇N split grains (1 − n_i), fluid n_i
+  ///    (E28), and the same split of a background gradient −V_i ∇p_0 (the viscous τ_f already acts
+  ///    on the fluid alone);
+  ///  * predicted velocities v = (mv + Δt f)/m;
+  ///  * semi-implicit drag (model.md §5): C_i = V_i C_V(φ_i, Re_i) with the predicted velocities,
+  ///    F_d = C_i/(1 + Δt C_i (1/m_s + 1/m_f)) Δv; grains −F_d, fluid +F_d.
+  void update_grid_and_couple() {
+    const double dt = opt_.dt_s;
+    for (int b = 0; b < body_count(); ++b)
+      if (b != grains_ && b != fluid_) update_grid_velocity(fields_[b], dt);
+    if (fluid_ < 0) {
+      if (grains_ >= 0) update_grid_velocity(fields_[grains_], dt);
+      return;
+    }
+    GridField<G>& s = fields_[grains_ >= 0 ? grains_ : fluid_];
+    GridField<G>& f = fields_[fluid_];
+    const bool grains = grains_ >= 0;
+    const auto& mx = opt_.mixture;
+    const int nn = f.nodes();
+    porosity_.resize(static_cast<std::size_t>(nn));
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < nn; ++i) {
+      const double V = f.volume_m3[i], ms = grains ? s.mass_kg[i] : 0.0, mf = f.mass_kg[i];
+      double n = 1.0;
+      if (V > 0.0 && ms > 0.0) n = std::clamp(1.0 - ms / (mx.rho_s_kg_m3 * V), mx.min_porosity, 1.0);
+      porosity_[i] = n;
+      const Vec<NC> Fp = f.pressure_force_N[i] - V * mx.background_pressure_gradient_Pa_m;
+      f.force_N[i] += n * Fp;
+      predict_node(f, i, dt);
+      if (!grains) continue;
+      s.force_N[i] += (1.0 - n) * Fp;
+      predict_node(s, i, dt);
+      if (!(ms > 0.0 && mf > 0.0 && V > 0.0)) continue;
+      const Vec<NC> dv = s.velocity[i] - f.velocity[i];
+      const double rho_f = mf / (n * V);
+      const double Re = material::drag_reynolds(dv.norm(), n, rho_f, mx.drag.d_m, mx.drag.eta_0_Pa_s);
+      const double C = V * material::drag_coefficient_per_volume(mx.drag, 1.0 - n, Re);
+      const Vec<NC> Fd = material::semi_implicit_drag_force(ms, mf, s.velocity[i], f.velocity[i], C, dt);
+      s.velocity[i] -= (dt / ms) * Fd;
+      f.velocity[i] += (dt / mf) * Fd;
+      s.force_N[i] -= Fd;  // kept for output/diagnostics
+      f.force_N[i] += Fd;
+    }
+  }
+
+  static void predict_node(GridField<G>& field, int i, double dt) {
+    const double m = field.mass_kg[i];
+    if (m > 0.0) {
+      field.velocity_old[i] = field.momentum[i] / m;
+      field.velocity[i] = (field.momentum[i] + dt * field.force_N[i]) / m;
+    } else {
+      field.velocity_old[i].setZero();
+      field.velocity[i].setZero();
+    }
+  }
+
+  void compute_mixture_flux() {
+    if (fluid_ < 0) return;
+    const GridField<G>& s = fields_[grains_ >= 0 ? grains_ : fluid_];  // n = 1 without grains
+    const GridField<G>& f = fields_[fluid_];
+    const int nn = f.nodes();
+    flux_.resize(static_cast<std::size_t>(nn));
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < nn; ++i) {
+      const double n = porosity_[i];
+      flux_[i] = (1.0 - n) * s.velocity[i] + n * f.velocity[i];
+    }
+  }
+
+  void apply_body_loads() {
+    if (opt_.gravity_m_s2.squaredNorm() == 0.0) return;
+    for (auto& f : fields_) add_gravity(f, opt_.gravity_m_s2);
+  }
+
+  void fold_wall_images_all() {
+    for (auto& f : fields_) fold_wall_images<G>(grid_, bc_, f);
+  }
+
+  void apply_boundary_conditions_all() {
+    for (auto& f : fields_) apply_boundary_conditions<G>(grid_, bc_, f, opt_.dt_s);
+  }
+
+  template <int K>
+  void grid_to_particles_all() {
+    for (std::size_t b = 0; b < bodies_.size(); ++b)
+      grid_to_particles<G, K>(*bodies_[b], caches_[b], fields_[b], grid_, opt_.transfer,
+                              opt_.flip_fraction, opt_.dt_s,
+                              static_cast<int>(b) == fluid_ ? porosity_.data() : nullptr,
+                              static_cast<int>(b) == fluid_ ? flux_.data() : nullptr);
+  }
+
+  void update_stresses() {
+    for (auto& b : bodies_)
+      if (b->law) b->law->update_stress(*b, opt_.dt_s);
+  }
+
+  Grid<D> grid_;
+  SolverOptions<G> opt_;
+  BoundaryConditions<D> bc_{};
+  std::vector<std::unique_ptr<Body<G>>> bodies_;
+  std::vector<ShapeCache<D>> caches_;
+  std::vector<GridField<G>> fields_;
+  int threads_ = 1;
+  int grains_ = -1, fluid_ = -1;
+  StepTimings timings_;
+  std::vector<double> porosity_;  ///< nodal porosity n_i of the mixture
+  std::vector<Vec<NC>> flux_;     ///< nodal mixture volume flux q_i
+  double time_s_ = 0.0;
+  std::int64_t steps_ = 0;
+};
+
+}  // namespace oobleck::mpm
