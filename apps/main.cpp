@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "oobleck 0.1.0");
   oobleck::cli::add_rheology_commands(app);
   oobleck::cli::add_point_commands(app);
+  oobleck::cli::add_run_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -121,6 +121,11 @@ class Solver {
   /// Nodal porosity of the last step (mixture only; empty otherwise).
   const std::vector<double>& nodal_porosity() const { return porosity_; }
   std::int64_t steps() const { return steps_; }
+  /// Restore the clock from a checkpoint (restart).
+  void set_clock(double time_s, std::int64_t steps) {
+    time_s_ = time_s;
+    steps_ = steps;
+  }
   int threads() const { return threads_; }
 
   /// Largest stable Δt [s]: the CFL condition on the fastest wave of every body

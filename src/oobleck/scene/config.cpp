@@ -174,6 +174,11 @@ SceneConfig load_scene(const std::string& path, const std::vector<std::string>& 
   }
   for (const auto& o : overrides) apply_override(root, path, o, c.aliases);
 
+  {
+    std::ostringstream resolved;
+    resolved << root;
+    c.resolved_toml = resolved.str();
+  }
   io::TomlReader top(root, path);
   (void)top.optional_table("aliases");
 
@@ -292,8 +297,10 @@ SceneConfig load_scene(const std::string& path, const std::vector<std::string>& 
               "must be an integer in [1, 8] (per axis)");
     const int ncomp = c.grid.geometry == Geometry::PlaneStrain ? 2 : 3;
     reg.velocity_m_s = read_vec(r, "velocity", ncomp, {0, 0, 0}, false, dim);
-    constexpr std::array<std::pair<const char*, InitialState>, 2> kInit{
-        {{"at_rest", InitialState::AtRest}, {"hydrostatic", InitialState::Hydrostatic}}};
+    constexpr std::array<std::pair<const char*, InitialState>, 3> kInit{
+        {{"at_rest", InitialState::AtRest},
+         {"hydrostatic", InitialState::Hydrostatic},
+         {"suspended", InitialState::Suspended}}};
     reg.initial_state = parse_enum(r, "initial_state", InitialState::AtRest, kInit);
     if (reg.phase == Phase::Elastic) {
       reg.elastic.density_kg_m3 = r.number("density");
@@ -374,6 +381,15 @@ SceneConfig load_scene(const std::string& path, const std::vector<std::string>& 
     o->require(ce >= 0 && ce == std::floor(ce), "checkpoint_every", ce, "must be a whole number of steps >= 0");
     c.output.checkpoint_every = static_cast<long>(ce);
     o->finish();
+  }
+  if (auto an = top.optional_table("analysis")) {
+    constexpr std::array<std::pair<const char*, AnalysisKind>, 3> kKinds{
+        {{"none", AnalysisKind::None}, {"settling", AnalysisKind::Settling}, {"couette", AnalysisKind::Couette}}};
+    c.analysis.kind = parse_enum(*an, "kind", AnalysisKind::None, kKinds);
+    c.analysis.average_from_s = an->number_or("average_from", 0.0);
+    an->require(c.analysis.average_from_s >= 0 && c.analysis.average_from_s < c.time.duration_s, "average_from",
+                c.analysis.average_from_s, "must lie in [0, time.duration) [s]");
+    an->finish();
   }
   top.finish();
   return c;

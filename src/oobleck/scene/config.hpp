@@ -18,7 +18,7 @@ enum class ShapeKind { Linear, Quadratic, Cubic, UGimp };
 enum class TransferScheme { Apic, Flip };
 enum class DragLaw { Beetstra, CarmanKozeny };
 enum class Phase { Mixture, Fluid, Grains, Elastic };
-enum class InitialState { AtRest, Hydrostatic };
+enum class InitialState { AtRest, Hydrostatic, Suspended };
 enum class BoundaryType { NoSlip, Slip, Friction, Velocity, Periodic, Open, Axis };
 
 const char* to_string(Geometry g);
@@ -88,8 +88,17 @@ struct OutputConfig {
   long checkpoint_every = 0;       ///< steps between checkpoints (0: none)
 };
 
+/// Built-in measurement written into summary.json (scenes/verification).
+enum class AnalysisKind { None, Settling, Couette };
+
+struct AnalysisConfig {
+  AnalysisKind kind = AnalysisKind::None;
+  double average_from_s = 0.0;  ///< [s] start of the time average (settling)
+};
+
 struct SceneConfig {
   std::string file;
+  std::string resolved_toml;  ///< the scene after --set overrides (stored with runs, for --restart)
   std::string name;
   std::string description;
   GridConfig grid;
@@ -102,6 +111,7 @@ struct SceneConfig {
   std::array<double, 3> gravity_m_s2{0, 0, 0};
   TimeConfig time;
   OutputConfig output;
+  AnalysisConfig analysis;
   std::map<std::string, std::string> aliases;  ///< short --set names -> full key paths
 };
 

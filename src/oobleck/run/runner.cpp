@@ -1,0 +1,707 @@
+#include "oobleck/run/runner.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <memory>
+
+#include <fmt/format.h>
+
+#include "oobleck/core/error.hpp"
+#include "oobleck/io/checkpoint.hpp"
+#include "oobleck/io/frames.hpp"
+#include "oobleck/io/output_file.hpp"
+#include "oobleck/io/progress.hpp"
+#include "oobleck/io/series.hpp"
+#include "oobleck/io/summary.hpp"
+#include "oobleck/material/drag.hpp"
+#include "oobleck/material/granular.hpp"
+#include "oobleck/mpm/granular_body_law.hpp"
+#include "oobleck/mpm/initial_state.hpp"
+#include "oobleck/mpm/laws.hpp"
+#include "oobleck/mpm/solver.hpp"
+
+namespace oobleck::run {
+
+std::string checkpoint_path(const std::string& run_dir) { return run_dir + "/checkpoint.h5"; }
+std::string stored_scene_path(const std::string& run_dir) { return run_dir + "/scene.toml"; }
+
+namespace {
+
+using scene::BoundaryType;
+using scene::SceneConfig;
+namespace fs = std::filesystem;
+
+/// View a vector of fixed-size Eigen objects as doubles (they are stored without padding).
+template <class T>
+std::span<double> as_doubles(std::vector<T>& v) {
+  static_assert(sizeof(T) == sizeof(double) * T::SizeAtCompileTime, "padded Eigen type");
+  return {reinterpret_cast<double*>(v.data()), v.size() * static_cast<std::size_t>(T::SizeAtCompileTime)};
+}
+template <class T>
+std::span<const double> as_doubles(const std::vector<T>& v) {
+  static_assert(sizeof(T) == sizeof(double) * T::SizeAtCompileTime, "padded Eigen type");
+  return {reinterpret_cast<const double*>(v.data()), v.size() * static_cast<std::size_t>(T::SizeAtCompileTime)};
+}
+
+template <class G>
+class SceneRun {
+ public:
+  static constexpr int D = G::dim;
+  static constexpr int NC = G::ncomp;
+  using Vd = mpm::Vec<D>;
+  using Vn = mpm::Vec<NC>;
+
+  SceneRun(const SceneConfig& cfg, const RunOptions& opt) : cfg_(cfg), opt_(opt) { build(); }
+
+  nlohmann::json run();
+
+ private:
+  void build();
+  void fill_regions();
+  void write_frame(io::FrameWriter& frames);
+  std::vector<std::string> series_columns() const;
+  std::vector<double> series_row() const;
+  void write_checkpoint() const;
+  void restore(const io::Checkpoint& cp);
+  void check_finite() const;
+  void sample_analysis();
+  nlohmann::json parameters() const;
+  nlohmann::json analysis_result() const;
+  long steps_between(double interval_s, long fallback) const {
+    return interval_s > 0 ? std::max(1L, static_cast<long>(std::llround(interval_s / dt_))) : fallback;
+  }
+
+  const SceneConfig& cfg_;
+  RunOptions opt_;
+  std::unique_ptr<mpm::Solver<G>> solver_;
+  int grains_ = -1, fluid_ = -1;
+  mpm::GranularBodyLaw<G>* granular_law_ = nullptr;
+  mpm::FluidLaw<G>* fluid_law_ = nullptr;
+  double dt_ = 0.0;
+  long total_steps_ = 0;
+  // settling analysis accumulators
+  double settle_sum_ = 0.0;
+  long settle_samples_ = 0;
+};
+
+template <class G>
+void SceneRun<G>::build() {
+  const auto& gc = cfg_.grid;
+  Vd origin;
+  std::array<int, D> cells{};
+  std::array<bool, D> periodic{};
+  for (int a = 0; a < D; ++a) {
+    origin[a] = gc.origin_m[a];
+    cells[a] = gc.cells[a];
+    periodic[a] = cfg_.boundary[2 * a].type == BoundaryType::Periodic;
+  }
+  mpm::Grid<D> grid(origin, gc.cell_size_m, cells, periodic);
+
+  mpm::SolverOptions<G> so;
+  so.dt_s = 1.0;  // set below, once the bodies exist
+  switch (gc.shape) {
+    case scene::ShapeKind::Linear: so.shape = mpm::ShapeKind::Linear; break;
+    case scene::ShapeKind::Quadratic: so.shape = mpm::ShapeKind::QuadraticBSpline; break;
+    case scene::ShapeKind::Cubic: so.shape = mpm::ShapeKind::CubicBSpline; break;
+    case scene::ShapeKind::UGimp: so.shape = mpm::ShapeKind::UGimp; break;
+  }
+  so.gimp_half_width_cells = 0.5 / cfg_.regions.front().points_per_cell;
+  so.transfer = cfg_.transfer.scheme == scene::TransferScheme::Apic ? mpm::Transfer::Apic : mpm::Transfer::FlipPicBlend;
+  so.flip_fraction = cfg_.transfer.flip_fraction;
+  so.gravity_m_s2 = Vn::Zero();
+  for (int a = 0; a < D; ++a) so.gravity_m_s2[a] = cfg_.gravity_m_s2[a];
+  so.threads = opt_.threads;
+  so.mixture.rho_s_kg_m3 = cfg_.material.granular.rho_s;
+  so.mixture.rho_f0_kg_m3 = cfg_.fluid.rho_f0_kg_m3;
+  so.mixture.min_porosity = cfg_.coupling.porosity_min;
+  so.mixture.drag.law = cfg_.coupling.drag == scene::DragLaw::Beetstra ? material::DragLaw::Beetstra
+                                                                       : material::DragLaw::CarmanKozeny;
+  so.mixture.drag.d_m = cfg_.material.granular.d;
+  so.mixture.drag.eta_0_Pa_s = cfg_.fluid.eta_0_Pa_s;
+  solver_ = std::make_unique<mpm::Solver<G>>(grid, so);
+
+  for (int face = 0; face < 2 * D; ++face) {
+    const scene::BoundaryConfig& b = cfg_.boundary[face];
+    mpm::FaceCondition& fc = solver_->boundaries()[face];
+    switch (b.type) {
+      case BoundaryType::NoSlip: fc.type = mpm::WallType::NoSlip; break;
+      case BoundaryType::Slip: fc.type = mpm::WallType::Slip; break;
+      case BoundaryType::Friction:
+        fc.type = mpm::WallType::Friction;
+        fc.friction_coefficient = b.friction;
+        break;
+      case BoundaryType::Velocity:
+        fc.type = mpm::WallType::Prescribed;
+        fc.velocity_m_s = Eigen::Vector3d(b.velocity_m_s[0], b.velocity_m_s[1], b.velocity_m_s[2]);
+        break;
+      case BoundaryType::Axis: fc.type = mpm::WallType::Axis; break;
+      case BoundaryType::Open:
+      case BoundaryType::Periodic: fc.type = mpm::WallType::Open; break;
+    }
+  }
+  fill_regions();
+
+  if (cfg_.time.dt_s) {
+    dt_ = *cfg_.time.dt_s;
+    solver_->options().dt_s = dt_;
+    try {
+      solver_->check_time_step(1.0);
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("{}: key 'time.dt' = {}: {}", cfg_.file, dt_, e.what()));
+    }
+  } else {
+    dt_ = solver_->stable_dt(cfg_.time.cfl);
+    if (!std::isfinite(dt_)) {
+      throw InputError(fmt::format("{}: no stable time step could be derived (no material with a wave speed); "
+                                   "set time.dt", cfg_.file));
+    }
+    solver_->options().dt_s = dt_;
+  }
+  total_steps_ = std::max(1L, static_cast<long>(std::llround(cfg_.time.duration_s / dt_)));
+}
+
+template <class G>
+void SceneRun<G>::fill_regions() {
+  const double h = cfg_.grid.cell_size_m;
+  const double rho_s = cfg_.material.granular.rho_s;
+  const double rho_f = cfg_.fluid.rho_f0_kg_m3;
+  auto ensure_grains = [&]() -> mpm::Body<G>& {
+    if (grains_ < 0) {
+      grains_ = solver_->body_count();
+      auto& b = solver_->add_body("grains", mpm::Phase::Grains);
+      auto law = std::make_unique<mpm::GranularBodyLaw<G>>(cfg_.material);
+      granular_law_ = law.get();
+      b.set_law(std::move(law));
+    }
+    return solver_->body(grains_);
+  };
+  auto ensure_fluid = [&]() -> mpm::Body<G>& {
+    if (fluid_ < 0) {
+      fluid_ = solver_->body_count();
+      auto& b = solver_->add_body("fluid", mpm::Phase::Fluid);
+      material::FluidParams fp;
+      fp.eta_0_Pa_s = cfg_.fluid.eta_0_Pa_s;
+      fp.kappa_Pa = cfg_.fluid.kappa_Pa;
+      fp.rho_f0_kg_m3 = rho_f;
+      auto law = std::make_unique<mpm::FluidLaw<G>>(fp, cfg_.coupling.porosity_min);
+      fluid_law_ = law.get();
+      b.set_law(std::move(law));
+    }
+    return solver_->body(fluid_);
+  };
+
+  double surface = -std::numeric_limits<double>::infinity();
+  double phi_bed = 0.0;
+  bool suspended = false;
+  for (const auto& r : cfg_.regions) {
+    Vd lo, hi;
+    for (int a = 0; a < D; ++a) {
+      lo[a] = r.min_m[a];
+      hi[a] = r.max_m[a];
+    }
+    Vn v0;
+    for (int c = 0; c < NC; ++c) v0[c] = r.velocity_m_s[c];
+    auto velocity = [v0](const Vd&) { return v0; };
+    switch (r.phase) {
+      case scene::Phase::Mixture:
+        mpm::fill_box(ensure_grains(), lo, hi, h, r.points_per_cell, r.phi * rho_s, velocity);
+        mpm::fill_box(ensure_fluid(), lo, hi, h, r.points_per_cell, (1.0 - r.phi) * rho_f, velocity);
+        break;
+      case scene::Phase::Grains:
+        mpm::fill_box(ensure_grains(), lo, hi, h, r.points_per_cell, r.phi * rho_s, velocity);
+        break;
+      case scene::Phase::Fluid:
+        mpm::fill_box(ensure_fluid(), lo, hi, h, r.points_per_cell, rho_f, velocity);
+        break;
+      case scene::Phase::Elastic: {
+        auto& b = solver_->add_body(r.name, mpm::Phase::Solid);
+        material::LinearElasticParams ep;
+        ep.youngs_modulus_Pa = r.elastic.youngs_modulus_Pa;
+        ep.poisson_ratio = r.elastic.poisson_ratio;
+        b.set_law(std::make_unique<mpm::LinearElasticLaw<G>>(ep));
+        mpm::fill_box(b, lo, hi, h, r.points_per_cell, r.elastic.density_kg_m3, velocity);
+        break;
+      }
+    }
+    if (r.initial_state != scene::InitialState::AtRest) {
+      surface = std::max(surface, r.max_m[D - 1]);
+      phi_bed = r.phi;
+      suspended = r.initial_state == scene::InitialState::Suspended;
+    }
+  }
+  for (int b = 0; b < solver_->body_count(); ++b) {
+    if (solver_->body(b).size() == 0) {
+      throw InputError(fmt::format("{}: body '{}' got no material points: regions must span at least one "
+                                   "point spacing (cell_size/points_per_cell)", cfg_.file, solver_->body(b).name));
+    }
+  }
+  if (std::isfinite(surface) && suspended) {
+    // Grains out of contact: the fluid pressure carries the whole mixture weight,
+    // p_f = rho_mix g depth with rho_mix = phi rho_s + (1 - phi) rho_f (E26: J = exp(-p_f/kappa)),
+    // and the granular stress is zero.
+    const double g = -cfg_.gravity_m_s2[D - 1];
+    const double rho_mix = phi_bed * rho_s + (1.0 - phi_bed) * rho_f;
+    if (fluid_ >= 0) {
+      auto& fl = solver_->body(fluid_);
+      for (std::int64_t p = 0; p < fl.size(); ++p) {
+        const double pf = rho_mix * g * std::max(surface - fl.x_m[p][D - 1], 0.0);
+        const double J = std::exp(-pf / cfg_.fluid.kappa_Pa);
+        fluid_law_->J[p] = J;
+        fl.mass_kg[p] /= J;
+        fl.stress_Pa[p] = -pf * mpm::Mat3::Identity();
+        fl.phi[p] = phi_bed;
+      }
+    }
+  } else if (std::isfinite(surface)) {
+    mpm::HydrostaticBed bed;
+    bed.surface_m = surface;
+    bed.g_m_s2 = -cfg_.gravity_m_s2[D - 1];
+    bed.rho_s_kg_m3 = rho_s;
+    bed.rho_f0_kg_m3 = rho_f;
+    const double K = cfg_.material.granular.K, Gm = cfg_.material.granular.G;
+    const double nu = (3 * K - 2 * Gm) / (2 * (3 * K + Gm));
+    bed.K0 = nu / (1 - nu);  // uniaxial-strain elastic skeleton
+    bed.phi_bed = phi_bed;
+    mpm::set_hydrostatic_bed<G>(bed, grains_ >= 0 ? &solver_->body(grains_) : nullptr,
+                                fluid_ >= 0 ? &solver_->body(fluid_) : nullptr);
+  }
+}
+
+template <class G>
+void SceneRun<G>::check_finite() const {
+  for (int b = 0; b < solver_->body_count(); ++b) {
+    auto& body = solver_->body(b);
+    const std::int64_t n = body.size();
+    std::int64_t bad = std::numeric_limits<std::int64_t>::max();
+#pragma omp parallel for schedule(static) reduction(min : bad)
+    for (std::int64_t p = 0; p < n; ++p) {
+      if (!body.x_m[p].allFinite() || !body.v_m_s[p].allFinite() || !body.stress_Pa[p].allFinite() ||
+          !std::isfinite(body.volume_m3[p])) {
+        bad = std::min(bad, p);
+      }
+    }
+    if (bad != std::numeric_limits<std::int64_t>::max()) {
+      const char* what = !body.x_m[bad].allFinite()        ? "position"
+                         : !body.v_m_s[bad].allFinite()     ? "velocity"
+                         : !body.stress_Pa[bad].allFinite() ? "stress"
+                                                            : "volume";
+      throw NumericalError(fmt::format(
+          "non-finite {} at step {} (t = {:.6g} s): body '{}' (law: {}), point {}; stopping before any output "
+          "of this step is written",
+          what, solver_->steps(), solver_->time_s(), body.name, body.law ? body.law->name() : "none", bad));
+    }
+  }
+}
+
+template <class G>
+void SceneRun<G>::write_frame(io::FrameWriter& frames) {
+  io::Frame frame;
+  frame.time = solver_->time_s();
+  frame.step = solver_->steps();
+  // Storage for the per-field arrays (the frame holds spans).
+  std::vector<std::vector<double>> store;
+  auto column = [&](std::size_t n) -> std::vector<double>& {
+    store.emplace_back(n, 0.0);
+    return store.back();
+  };
+  store.reserve(64 * static_cast<std::size_t>(solver_->body_count()) + 16);
+  for (int b = 0; b < solver_->body_count(); ++b) {
+    const auto& body = solver_->body(b);
+    const auto n = static_cast<std::size_t>(body.size());
+    std::array<std::vector<double>*, 3> pos{};
+    for (int a = 0; a < D; ++a) {
+      pos[a] = &column(n);
+      for (std::size_t p = 0; p < n; ++p) (*pos[a])[p] = body.x_m[p][a];
+    }
+    io::PointCloud cloud = D == 2 ? io::PointCloud(body.name, {*pos[0], *pos[1]})
+                                  : io::PointCloud(body.name, {*pos[0], *pos[1], *pos[2]});
+    std::array<std::vector<double>*, 3> vel{};
+    for (int c = 0; c < NC; ++c) {
+      vel[c] = &column(n);
+      for (std::size_t p = 0; p < n; ++p) (*vel[c])[p] = body.v_m_s[p][c];
+    }
+    if (NC == 2) cloud.vector("velocity", {*vel[0], *vel[1]});
+    else cloud.vector("velocity", {*vel[0], *vel[1], *vel[2]});
+    std::array<std::vector<double>*, 6> s6{};
+    const int idx[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};
+    for (int k = 0; k < 6; ++k) {
+      s6[k] = &column(n);
+      for (std::size_t p = 0; p < n; ++p) (*s6[k])[p] = body.stress_Pa[p](idx[k][0], idx[k][1]);
+    }
+    cloud.sym_tensor("stress", {*s6[0], *s6[1], *s6[2], *s6[3], *s6[4], *s6[5]});
+    auto& pressure = column(n);
+    for (std::size_t p = 0; p < n; ++p) pressure[p] = -body.stress_Pa[p].trace() / 3.0;
+    cloud.scalar(b == fluid_ ? "fluid_pressure" : "pressure", pressure);
+    cloud.scalar("mass", body.mass_kg).scalar("volume", body.volume_m3);
+    if (b == grains_) {
+      auto& phi = column(n);
+      auto& tau = column(n);
+      auto& regime = column(n);
+      for (std::size_t p = 0; p < n; ++p) {
+        phi[p] = granular_law_->phi_of(body, static_cast<std::int64_t>(p));
+        tau[p] = material::tau_bar(body.stress_Pa[p]);
+        regime[p] = granular_law_->regime[p];
+      }
+      cloud.scalar("f", granular_law_->f).scalar("phi", phi).scalar("tau_bar", tau);
+      cloud.scalar("regime", regime).scalar("gamma_dot_p", granular_law_->gamma_dot_p);
+    }
+    if (b == fluid_) cloud.scalar("phi", body.phi).scalar("J", fluid_law_->J);
+    frame.bodies.push_back(std::move(cloud));
+  }
+  // Nodal porosity on the physical nodes (x fastest), when there is a mixture.
+  const auto& n_nodal = solver_->nodal_porosity();
+  if (!n_nodal.empty()) {
+    const auto& grid = solver_->grid();
+    std::array<std::size_t, 3> nodes{1, 1, 1};
+    for (int a = 0; a < D; ++a) nodes[a] = static_cast<std::size_t>(grid.periodic[a] ? grid.cells[a] : grid.cells[a] + 1);
+    auto& values = column(nodes[0] * nodes[1] * nodes[2]);
+    for (std::size_t k = 0; k < nodes[2]; ++k) {
+      for (std::size_t j = 0; j < nodes[1]; ++j) {
+        for (std::size_t i = 0; i < nodes[0]; ++i) {
+          const int logical[3] = {static_cast<int>(i), static_cast<int>(j), static_cast<int>(k)};
+          int flat = 0;
+          for (int a = 0; a < D; ++a) flat += grid.storage_index(a, logical[a]) * grid.stride(a);
+          values[i + nodes[0] * (j + nodes[1] * k)] = n_nodal[static_cast<std::size_t>(flat)];
+        }
+      }
+    }
+    std::array<double, 3> origin{0, 0, 0}, spacing{0, 0, 0};
+    for (int a = 0; a < D; ++a) {
+      origin[a] = grid.origin_m[a];
+      spacing[a] = grid.h_m;
+    }
+    io::NodeGrid ng(D, origin, spacing, nodes);
+    ng.scalar("porosity", values);
+    frame.grid = std::move(ng);
+  }
+  frames.write(frame);
+}
+
+template <class G>
+std::vector<std::string> SceneRun<G>::series_columns() const {
+  std::vector<std::string> c = {"time", "step"};
+  for (int b = 0; b < solver_->body_count(); ++b) {
+    const std::string& n = solver_->body(b).name;
+    c.push_back("kinetic_energy_" + n);
+    for (int k = 0; k < NC; ++k) c.push_back(fmt::format("momentum_{}_{}", n, k));
+    c.push_back("mass_" + n);
+    c.push_back("max_speed_" + n);
+  }
+  return c;
+}
+
+template <class G>
+std::vector<double> SceneRun<G>::series_row() const {
+  std::vector<double> r = {solver_->time_s(), static_cast<double>(solver_->steps())};
+  for (int b = 0; b < solver_->body_count(); ++b) {
+    const auto& body = solver_->body(b);
+    r.push_back(body.kinetic_energy());
+    const Vn P = body.total_momentum();
+    for (int k = 0; k < NC; ++k) r.push_back(P[k]);
+    r.push_back(body.total_mass());
+    double vmax = 0.0;
+    for (const auto& v : body.v_m_s) vmax = std::max(vmax, v.norm());
+    r.push_back(vmax);
+  }
+  return r;
+}
+
+template <class G>
+void SceneRun<G>::write_checkpoint() const {
+  io::CheckpointWriter cp(checkpoint_path(opt_.out_dir));
+  cp.set_step(solver_->steps());
+  cp.set_time(solver_->time_s());
+  cp.set_config(cfg_.resolved_toml);
+  cp.attribute("dt", dt_);
+  cp.attribute("threads", static_cast<std::int64_t>(solver_->threads()));
+  cp.attribute("settle_sum", settle_sum_);
+  cp.attribute("settle_samples", static_cast<std::int64_t>(settle_samples_));
+  for (int b = 0; b < solver_->body_count(); ++b) {
+    auto& body = solver_->body(b);
+    const std::string p = fmt::format("body{}/", b);
+    cp.array(p + "mass", body.mass_kg);
+    cp.array(p + "volume", body.volume_m3);
+    cp.array(p + "volume0", body.volume0_m3);
+    cp.array(p + "x", as_doubles(body.x_m));
+    cp.array(p + "v", as_doubles(body.v_m_s));
+    cp.array(p + "C", as_doubles(body.C_1_s));
+    cp.array(p + "L", as_doubles(body.L_1_s));
+    cp.array(p + "stress", as_doubles(body.stress_Pa));
+    cp.array(p + "f_ext", as_doubles(body.f_ext_N));
+    cp.array(p + "phi", body.phi);
+    cp.array(p + "div_q", body.div_q_1_s);
+  }
+  if (granular_law_) {
+    cp.array("granular/f", granular_law_->f);
+    cp.array("granular/regime", granular_law_->regime);
+    cp.array("granular/gamma_dot_p", granular_law_->gamma_dot_p);
+  }
+  if (fluid_law_) cp.array("fluid/J", fluid_law_->J);
+  cp.commit();
+}
+
+template <class G>
+void SceneRun<G>::restore(const io::Checkpoint& cp) {
+  if (cp.real_attribute("dt") != dt_) {
+    throw InputError(fmt::format("{}: time step {} s differs from the checkpoint's {} s", cp.file(), dt_,
+                                 cp.real_attribute("dt")));
+  }
+  for (int b = 0; b < solver_->body_count(); ++b) {
+    auto& body = solver_->body(b);
+    const std::string p = fmt::format("body{}/", b);
+    cp.read_into(p + "mass", body.mass_kg);
+    cp.read_into(p + "volume", body.volume_m3);
+    cp.read_into(p + "volume0", body.volume0_m3);
+    cp.read_into(p + "x", as_doubles(body.x_m));
+    cp.read_into(p + "v", as_doubles(body.v_m_s));
+    cp.read_into(p + "C", as_doubles(body.C_1_s));
+    cp.read_into(p + "L", as_doubles(body.L_1_s));
+    cp.read_into(p + "stress", as_doubles(body.stress_Pa));
+    cp.read_into(p + "f_ext", as_doubles(body.f_ext_N));
+    cp.read_into(p + "phi", body.phi);
+    cp.read_into(p + "div_q", body.div_q_1_s);
+  }
+  if (granular_law_) {
+    cp.read_into("granular/f", granular_law_->f);
+    cp.read_into("granular/regime", granular_law_->regime);
+    cp.read_into("granular/gamma_dot_p", granular_law_->gamma_dot_p);
+  }
+  if (fluid_law_) cp.read_into("fluid/J", fluid_law_->J);
+  settle_sum_ = cp.real_attribute("settle_sum");
+  settle_samples_ = static_cast<long>(cp.int_attribute("settle_samples"));
+  solver_->set_clock(cp.time(), cp.step());
+}
+
+template <class G>
+void SceneRun<G>::sample_analysis() {
+  if (cfg_.analysis.kind != scene::AnalysisKind::Settling || grains_ < 0 || fluid_ < 0) return;
+  if (solver_->time_s() < cfg_.analysis.average_from_s) return;
+  // Mean vertical velocities of both phases in the middle half of the column, the mixture volume
+  // flux j = phi v_s + (1 - phi) v_f there, and the settling velocity -(v_s - j), positive down.
+  const auto& reg = cfg_.regions.front();
+  const double z0 = reg.min_m[D - 1], z1 = reg.max_m[D - 1];
+  const double lo = z0 + 0.25 * (z1 - z0), hi = z1 - 0.25 * (z1 - z0);
+  auto mean_v = [&](const mpm::Body<G>& body, double& volume) {
+    double mv = 0.0, m = 0.0;
+    volume = 0.0;
+    for (std::int64_t p = 0; p < body.size(); ++p) {
+      if (body.x_m[p][D - 1] < lo || body.x_m[p][D - 1] > hi) continue;
+      mv += body.mass_kg[p] * body.v_m_s[p][D - 1];
+      m += body.mass_kg[p];
+      volume += body.volume_m3[p];
+    }
+    return m > 0 ? mv / m : 0.0;
+  };
+  double vol_s = 0.0, vol_f = 0.0;
+  const double vs = mean_v(solver_->body(grains_), vol_s);
+  const double vf = mean_v(solver_->body(fluid_), vol_f);
+  const double phi = reg.phi;
+  const double j = phi * vs + (1.0 - phi) * vf;
+  settle_sum_ += -(vs - j);
+  ++settle_samples_;
+}
+
+template <class G>
+nlohmann::json SceneRun<G>::parameters() const {
+  const auto& s = cfg_.material.steady;
+  const auto& g = cfg_.material.granular;
+  nlohmann::json p;
+  p["preset"] = cfg_.material.name;
+  p["phi"] = cfg_.regions.front().phi;
+  p["rho_s"] = g.rho_s;
+  p["rho_f"] = cfg_.fluid.rho_f0_kg_m3;
+  p["eta_0"] = cfg_.fluid.eta_0_Pa_s;
+  p["kappa"] = cfg_.fluid.kappa_Pa;
+  p["d"] = g.d;
+  p["G"] = g.G;
+  p["K"] = g.K;
+  p["K_0"] = g.K_0;
+  p["K_3"] = g.K_3;
+  p["K_4"] = g.K_4;
+  p["mu_1"] = s.mu_c;
+  p["mu_2"] = g.mu_2 < 0 ? s.mu_c : g.mu_2;
+  p["b"] = g.b;
+  p["phi_c"] = s.phi_c;
+  p["phi_j"] = s.phi_j;
+  p["a_0"] = s.a_0;
+  p["a_inf"] = s.a_inf;
+  p["tau_star"] = s.tau_star;
+  p["Delta"] = s.Delta;
+  p["xi_dot_eps"] = s.xi_dot_eps;
+  nlohmann::json terms = nlohmann::json::array();
+  for (const auto& t : s.eta_B_terms) terms.push_back({{"phi_i", t.phi_i}, {"alpha", t.alpha}});
+  p["eta_B"] = terms;
+  p["gravity"] = std::vector<double>(cfg_.gravity_m_s2.begin(), cfg_.gravity_m_s2.begin() + D);
+  p["porosity_min"] = cfg_.coupling.porosity_min;
+  p["drag"] = cfg_.coupling.drag == scene::DragLaw::Beetstra ? "beetstra" : "carman_kozeny";
+  p["cell_size"] = cfg_.grid.cell_size_m;
+  p["cells"] = std::vector<int>(cfg_.grid.cells.begin(), cfg_.grid.cells.begin() + D);
+  p["shape_function"] = scene::to_string(cfg_.grid.shape);
+  p["transfer"] = cfg_.transfer.scheme == scene::TransferScheme::Apic ? "apic" : "flip";
+  if (cfg_.transfer.scheme == scene::TransferScheme::Flip) p["flip_fraction"] = cfg_.transfer.flip_fraction;
+  if (cfg_.grid.geometry == scene::Geometry::Axisymmetric) {
+    p["r_inner"] = cfg_.grid.origin_m[0];
+    p["r_outer"] = cfg_.grid.origin_m[0] + cfg_.grid.size_m[0];
+    p["height"] = cfg_.grid.size_m[1];
+    if (cfg_.boundary[0].type == BoundaryType::Velocity) p["u_inner"] = cfg_.boundary[0].velocity_m_s[2];
+  }
+  return p;
+}
+
+template <class G>
+nlohmann::json SceneRun<G>::analysis_result() const {
+  nlohmann::json a = nlohmann::json::object();
+  if (cfg_.analysis.kind == scene::AnalysisKind::Settling) {
+    // Drag-buoyancy balance (derivation in docs/verification.md): with zero mixture volume flux
+    // the fluid pressure gradient carries the mixture weight, so per mixture volume the drag
+    // balances phi (1 - phi)(rho_s - rho_f) g: 18 phi (1-phi) eta_0/d^2 F(phi, Re) w = phi (1-phi) drho g,
+    // w = v_s - v_f the slip velocity; the grain velocity in the zero-flux frame is (1 - phi) w.
+    const double phi = cfg_.regions.front().phi;
+    const double g = std::fabs(cfg_.gravity_m_s2[D - 1]);
+    const double drho = cfg_.material.granular.rho_s - cfg_.fluid.rho_f0_kg_m3;
+    material::DragParams dp = solver_->options().mixture.drag;
+    double w = 0.0;
+    for (int it = 0; it < 100; ++it) {
+      const double Re = material::drag_reynolds(w, 1.0 - phi, cfg_.fluid.rho_f0_kg_m3, dp.d_m, dp.eta_0_Pa_s);
+      const double w_new = drho * g * dp.d_m * dp.d_m / (18.0 * dp.eta_0_Pa_s * material::drag_F(dp, phi, Re));
+      if (std::fabs(w_new - w) <= 1e-14 * std::fabs(w_new)) {
+        w = w_new;
+        break;
+      }
+      w = w_new;
+    }
+    a["settling_velocity"] = settle_samples_ > 0 ? settle_sum_ / static_cast<double>(settle_samples_) : NAN;
+    a["settling_velocity_analytic"] = (1.0 - phi) * w;
+    a["settling_samples"] = settle_samples_;
+  }
+  if (cfg_.analysis.kind == scene::AnalysisKind::Couette && fluid_ >= 0 && NC == 3) {
+    // Torque on a coaxial cylinder of radius r: M(r) = 2 pi r^2 H tau_r_theta (whole cylinder).
+    // At steady state r^2 tau_r_theta is uniform in the gap (torque balance); a least-squares line
+    // of r^2 tau_r_theta against r over all fluid points, evaluated at each wall, gives the wall
+    // torques (their difference measures the discretization error). Analytic: M = 4 pi eta B H.
+    const auto& body = solver_->body(fluid_);
+    const double ri = cfg_.grid.origin_m[0], ro = ri + cfg_.grid.size_m[0];
+    const double H = cfg_.grid.size_m[1];
+    double sr = 0, sm = 0, srr = 0, srm = 0;
+    const auto np = static_cast<double>(body.size());
+    for (std::int64_t p = 0; p < body.size(); ++p) {
+      const double r = body.x_m[p][0];
+      const double m = r * r * body.stress_Pa[p](0, 2);
+      sr += r;
+      sm += m;
+      srr += r * r;
+      srm += r * m;
+    }
+    const double slope = (np * srm - sr * sm) / (np * srr - sr * sr);
+    const double icpt = (sm - slope * sr) / np;
+    a["torque_inner"] = std::fabs(2.0 * M_PI * H * (icpt + slope * ri));
+    a["torque_outer"] = std::fabs(2.0 * M_PI * H * (icpt + slope * ro));
+    const double eta = cfg_.fluid.eta_0_Pa_s;
+    const double U = cfg_.boundary[0].velocity_m_s[2];
+    const double B = U * ri * ro * ro / (ro * ro - ri * ri);
+    a["torque_analytic"] = std::fabs(4.0 * M_PI * eta * B * H);
+    // Velocity profile error against A r + B/r at the points (L2 relative to U).
+    const double A = -U * ri / (ro * ro - ri * ri);
+    double e2 = 0.0;
+    for (std::int64_t p = 0; p < body.size(); ++p) {
+      const double r = body.x_m[p][0];
+      const double d = body.v_m_s[p][2] - (A * r + B / r);
+      e2 += d * d;
+    }
+    a["velocity_profile_rms_error"] = std::sqrt(e2 / static_cast<double>(body.size())) / std::fabs(U);
+  }
+  return a;
+}
+
+template <class G>
+nlohmann::json SceneRun<G>::run() {
+  fs::create_directories(opt_.out_dir);
+  const long every_frame = steps_between(cfg_.output.frame_interval_s, std::numeric_limits<long>::max());
+  const long every_series = steps_between(cfg_.output.series_interval_s, 100);
+  const long every_cp = opt_.checkpoint_every >= 0 ? opt_.checkpoint_every : cfg_.output.checkpoint_every;
+
+  std::optional<io::FrameWriter> frames;
+  std::optional<io::SeriesWriter> series;
+  if (opt_.restart) {
+    const io::Checkpoint cp = io::read_checkpoint(checkpoint_path(opt_.out_dir));
+    restore(cp);
+    frames.emplace(io::FrameWriter::resume(opt_.out_dir, cp.step()));
+    series.emplace(io::SeriesWriter::resume(opt_.out_dir + "/series.csv", series_columns(), cp.time()));
+  } else {
+    io::write_file_atomically(stored_scene_path(opt_.out_dir), cfg_.resolved_toml, "scene copy");
+    frames.emplace(opt_.out_dir);
+    series.emplace(opt_.out_dir + "/series.csv", series_columns());
+    write_frame(*frames);
+    series->row(series_row());
+  }
+
+  std::int64_t points = 0;
+  nlohmann::json per_body;
+  for (int b = 0; b < solver_->body_count(); ++b) {
+    points += solver_->body(b).size();
+    per_body[solver_->body(b).name] = solver_->body(b).size();
+  }
+  io::ProgressOptions po;
+  po.quiet = opt_.quiet;
+  po.points_per_step = static_cast<double>(points);
+  po.label = cfg_.name;
+  io::Progress progress(static_cast<std::uint64_t>(total_steps_), po);
+
+  const long first = static_cast<long>(solver_->steps());
+  const long last = opt_.stop_after_steps >= 0 ? std::min<long>(opt_.stop_after_steps, total_steps_) : total_steps_;
+  solver_->reset_timings();
+  const auto t0 = std::chrono::steady_clock::now();
+  for (long s = first + 1; s <= last; ++s) {
+    solver_->step();
+    check_finite();
+    sample_analysis();
+    if (s % every_frame == 0 || s == total_steps_) write_frame(*frames);
+    if (s % every_series == 0 || s == total_steps_) series->row(series_row());
+    if (every_cp > 0 && s % every_cp == 0) write_checkpoint();
+    progress.update(static_cast<std::uint64_t>(s), solver_->time_s());
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (last < total_steps_) write_checkpoint();  // stopped early: leave a checkpoint to continue from
+  progress.finish();
+  frames->flush();
+
+  const long steps_run = last - first;
+  const auto& tm = solver_->timings();
+  nlohmann::json j;
+  j["scene"] = cfg_.name;
+  j["scene_file"] = cfg_.file;
+  j["geometry"] = scene::to_string(cfg_.grid.geometry);
+  j["points"] = points;
+  j["points_per_body"] = per_body;
+  j["steps"] = solver_->steps();
+  j["steps_this_run"] = steps_run;
+  j["complete"] = last == total_steps_;
+  j["dt"] = dt_;
+  j["time"] = solver_->time_s();
+  j["wall_seconds"] = wall;
+  j["point_updates_per_second"] = wall > 0 ? static_cast<double>(points) * static_cast<double>(steps_run) / wall : 0.0;
+  j["threads"] = solver_->threads();
+  j["timings_seconds"] = {{"shape", tm.shape}, {"p2g", tm.p2g}, {"grid", tm.grid}, {"g2p", tm.g2p},
+                          {"stress", tm.stress}, {"output_and_checks", wall - tm.total()}};
+  j["parameters"] = parameters();
+  const nlohmann::json analysis = analysis_result();
+  j.update(analysis);
+  io::write_summary(opt_.out_dir, j);
+  return j;
+}
+
+}  // namespace
+
+nlohmann::json run_scene(const SceneConfig& config, const RunOptions& options) {
+  if (options.out_dir.empty()) throw InputError("run: empty output folder");
+  switch (config.grid.geometry) {
+    case scene::Geometry::PlaneStrain: return SceneRun<mpm::PlaneStrain>(config, options).run();
+    case scene::Geometry::Axisymmetric: return SceneRun<mpm::Axisymmetric>(config, options).run();
+    case scene::Geometry::ThreeD: return SceneRun<mpm::ThreeD>(config, options).run();
+  }
+  return {};
+}
+
+}  // namespace oobleck::run

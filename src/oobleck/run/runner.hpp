@@ -1,0 +1,30 @@
+#pragma once
+// `oobleck run`: a scene file becomes a two-phase MPM run with HDF5/XDMF frames, a CSV series of
+// global quantities, checkpoints and summary.json (issue 4, items 7–8).
+#include <cstdint>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "oobleck/scene/config.hpp"
+
+namespace oobleck::run {
+
+struct RunOptions {
+  std::string out_dir;             ///< run folder (created)
+  int threads = 0;                 ///< OpenMP threads (0: default)
+  long checkpoint_every = -1;      ///< steps between checkpoints (-1: the scene's value)
+  bool quiet = false;              ///< no progress output
+  bool restart = false;            ///< continue from out_dir/checkpoint.h5
+  long stop_after_steps = -1;      ///< stop (with a checkpoint) after this many steps in total (tests)
+};
+
+/// Run the scene to its end and return the summary (also written to out_dir/summary.json).
+nlohmann::json run_scene(const scene::SceneConfig& config, const RunOptions& options);
+
+/// Path of the checkpoint file in a run folder.
+std::string checkpoint_path(const std::string& run_dir);
+/// Path of the resolved scene stored in a run folder (used by --restart).
+std::string stored_scene_path(const std::string& run_dir);
+
+}  // namespace oobleck::run

@@ -1,0 +1,133 @@
+// `oobleck run` end to end on the verification scenes: the measured quantity written into
+// summary.json against its analytic value (V3 torque, V4 settling), exact mass conservation,
+// restart equality, and refusal of invalid scenes before any output.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "../cli/cli_runner.hpp"
+#include "oobleck/core/error.hpp"
+#include "oobleck/io/checkpoint.hpp"
+#include "oobleck/io/csv.hpp"
+#include "oobleck/run/runner.hpp"
+#include "oobleck/scene/config.hpp"
+
+namespace fs = std::filesystem;
+using namespace oobleck;
+
+namespace {
+const std::string kScenes = std::string(OOBLECK_SOURCE_DIR) + "/scenes/verification/";
+
+nlohmann::json run_verification(const std::string& scene, const std::string& out, std::vector<std::string> sets = {},
+                   run::RunOptions o = {}) {
+  o.out_dir = out;
+  o.quiet = true;
+  if (o.threads == 0) o.threads = 1;
+  return run::run_scene(scene::load_scene(kScenes + scene, sets), o);
+}
+double rel(double a, double b) { return std::fabs(a - b) / std::fabs(b); }
+}  // namespace
+
+TEST(RunScenes, SettlingVelocityMatchesDragBuoyancyBalanceV4) {
+  clitest::TempDir d;
+  const auto s = run_verification("settling.toml", d / "run");
+  EXPECT_LT(rel(s["settling_velocity"].get<double>(), s["settling_velocity_analytic"].get<double>()), 0.01);
+  // Independent check of the analytic value in the Stokes limit written out here (Beetstra F at
+  // Re -> 0: 10 phi/(1-phi)^2 + (1-phi)^2 (1 + 1.5 sqrt(phi))); the finite-Re term is < 2 % here.
+  const double phi = 0.1, d_m = 1e-4, eta = 1e-3, drho = 620.0, g = 9.81;
+  const double F0 = 10 * phi / std::pow(1 - phi, 2) + std::pow(1 - phi, 2) * (1 + 1.5 * std::sqrt(phi));
+  const double u_stokes = (1 - phi) * drho * g * d_m * d_m / (18 * eta * F0);
+  EXPECT_LT(rel(s["settling_velocity_analytic"].get<double>(), u_stokes), 0.02);
+  EXPECT_EQ(s["parameters"]["phi"].get<double>(), 0.1);
+  EXPECT_EQ(s["parameters"]["rho_f"].get<double>(), 1000.0);
+  for (const char* key : {"points", "steps", "wall_seconds", "point_updates_per_second", "threads"}) {
+    EXPECT_TRUE(s.contains(key)) << key;
+  }
+  // Mass is carried by the points: the series' total masses are constant to the last bit.
+  const auto series = io::read_csv(d / "run/series.csv");
+  for (const char* col : {"mass_grains", "mass_fluid"}) {
+    const auto m = series.column(col);
+    for (double v : m) ASSERT_EQ(v, m.front()) << col;
+  }
+  EXPECT_TRUE(fs::exists(d / "run/frames.xmf"));
+  EXPECT_TRUE(fs::exists(d / "run/summary.json"));
+}
+
+TEST(RunScenes, TaylorCouetteTorquesV3) {
+  clitest::TempDir d;
+  run::RunOptions o;
+  o.threads = 1;
+  const auto s = run_verification("couette_axisym.toml", d / "run", {}, o);
+  const double M = s["torque_analytic"].get<double>();
+  // Independent analytic torque: M = 4 pi eta B H, B = U r_i r_o^2/(r_o^2 - r_i^2).
+  const double ri = 0.01, ro = 0.02, U = 0.01, H = 0.004, eta = 1.0;
+  EXPECT_LT(rel(M, 4 * M_PI * eta * U * ri * ro * ro / (ro * ro - ri * ri) * H), 1e-12);
+  EXPECT_LT(rel(s["torque_inner"].get<double>(), M), 0.01);
+  EXPECT_LT(rel(s["torque_outer"].get<double>(), M), 0.01);
+  EXPECT_LT(s["velocity_profile_rms_error"].get<double>(), 0.01);
+  EXPECT_EQ(s["parameters"]["r_inner"].get<double>(), ri);
+  EXPECT_EQ(s["parameters"]["r_outer"].get<double>(), ro);
+  EXPECT_EQ(s["parameters"]["u_inner"].get<double>(), U);
+}
+
+TEST(RunScenes, RestartContinuesBitForBit) {
+  clitest::TempDir d;
+  run::RunOptions o;
+  o.checkpoint_every = 100;
+  o.threads = 1;
+  run_verification("settling.toml", d / "full", {"time.duration=0.01"}, o);          // 359 steps, checkpoint at 300
+  o.stop_after_steps = 150;
+  run_verification("settling.toml", d / "part", {"time.duration=0.01"}, o);          // stops at 150 with a checkpoint
+  o.stop_after_steps = -1;
+  o.restart = true;
+  o.out_dir = d / "part";
+  o.quiet = true;
+  run::run_scene(scene::load_scene(run::stored_scene_path(d / "part")), o);
+  const auto a = io::read_checkpoint(run::checkpoint_path(d / "full"));
+  const auto b = io::read_checkpoint(run::checkpoint_path(d / "part"));
+  ASSERT_EQ(a.step(), 300);
+  ASSERT_EQ(b.step(), 300);
+  EXPECT_EQ(a.time(), b.time());
+  ASSERT_EQ(a.names(), b.names());
+  for (const auto& n : a.names()) {
+    if (n == "granular/regime") {
+      EXPECT_EQ(a.bytes(n), b.bytes(n));
+    } else {
+      EXPECT_EQ(a.doubles(n), b.doubles(n)) << n;  // bitwise equality of every state array
+    }
+  }
+  // The series of the restarted run continues without duplicate rows.
+  const auto s = io::read_csv(d / "part/series.csv").column("step");
+  for (std::size_t i = 1; i < s.size(); ++i) ASSERT_GT(s[i], s[i - 1]);
+}
+
+TEST(RunScenes, InvalidScenesAreRefusedBeforeAnyOutput) {
+  clitest::TempDir d;
+  std::string text;
+  {
+    std::ifstream in(kScenes + "settling.toml");
+    text.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  struct Case {
+    std::string from, to, message;
+  };
+  const Case cases[] = {
+      {"kappa = 2.0e5", "kappa = 2.0e5\nviscosity = 1", "unknown key"},
+      {"G = 1.0e4", "G = -1.0e4", "granular.G"},
+      {"cell_size = 0.001", "cell_size = \"1 mm\"", "must be a number"},
+      {"duration = 0.02", "duration = 0.02\ndt = 0.01", "stable"},
+  };
+  for (const auto& c : cases) {
+    std::string t = text;
+    t.replace(t.find(c.from), c.from.size(), c.to);
+    std::ofstream(d / "bad.toml") << t;
+    const auto r = clitest::run("run " + d / "bad.toml" + " --out " + d / "out" + " --quiet");
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find(c.message), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("bad.toml"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(d / "out")) << c.message;
+  }
+}
