@@ -8,6 +8,8 @@
 
 #include <fmt/format.h>
 
+#include "oobleck/analysis/annular.hpp"
+#include "oobleck/analysis/summary_json.hpp"
 #include "oobleck/core/error.hpp"
 #include "oobleck/io/checkpoint.hpp"
 #include "oobleck/io/frames.hpp"
@@ -84,6 +86,10 @@ class SceneRun {
   // settling analysis accumulators
   double settle_sum_ = 0.0;
   long settle_samples_ = 0;
+  // annular analysis: nodal mixture v_theta samples
+  std::vector<analysis::ShearFrame> shear_frames_;
+  void sample_shear_frame();
+  analysis::AnnularGeometry annular_geometry() const;
 };
 
 template <class G>
@@ -504,6 +510,50 @@ void SceneRun<G>::sample_analysis() {
 }
 
 template <class G>
+analysis::AnnularGeometry SceneRun<G>::annular_geometry() const {
+  analysis::AnnularGeometry g;
+  g.bob_radius_m = cfg_.grid.origin_m[0];
+  g.outer_radius_m = cfg_.grid.origin_m[0] + cfg_.grid.size_m[0];
+  g.bob_speed_m_per_s = cfg_.boundary[0].velocity_m_s[2];
+  double top = -INFINITY;
+  for (const auto& r : cfg_.regions) top = std::max(top, r.max_m[D - 1]);
+  g.sample_z_m = std::isfinite(cfg_.analysis.sample_z_m) ? cfg_.analysis.sample_z_m : top - 2.0 * cfg_.grid.cell_size_m;
+  g.start_time_s = 0.0;
+  return g;
+}
+
+template <class G>
+void SceneRun<G>::sample_shear_frame() {
+  if constexpr (NC == 3 && D == 2) {
+    // Mass-weighted mixture v_theta on the physical nodes (r fastest).
+    const auto& grid = solver_->grid();
+    analysis::ShearFrame fr;
+    fr.time_s = solver_->time_s();
+    fr.v_theta.origin_x = grid.origin_m[0];
+    fr.v_theta.origin_y = grid.origin_m[1];
+    fr.v_theta.h = grid.h_m;
+    fr.v_theta.nx = static_cast<std::size_t>(grid.cells[0] + 1);
+    fr.v_theta.ny = static_cast<std::size_t>(grid.periodic[1] ? grid.cells[1] : grid.cells[1] + 1);
+    fr.v_theta.values.assign(fr.v_theta.nx * fr.v_theta.ny, 0.0);
+    for (std::size_t j = 0; j < fr.v_theta.ny; ++j) {
+      for (std::size_t i = 0; i < fr.v_theta.nx; ++i) {
+        const int flat = grid.storage_index(0, static_cast<int>(i)) * grid.stride(0) +
+                         grid.storage_index(1, static_cast<int>(j)) * grid.stride(1);
+        double m = 0.0, mv = 0.0;
+        for (int b : {grains_, fluid_}) {
+          if (b < 0) continue;
+          const auto& fld = solver_->field(b);
+          m += fld.mass_kg[flat];
+          mv += fld.mass_kg[flat] * fld.velocity[flat][2];
+        }
+        fr.v_theta.values[j * fr.v_theta.nx + i] = m > 0 ? mv / m : 0.0;
+      }
+    }
+    shear_frames_.push_back(std::move(fr));
+  }
+}
+
+template <class G>
 nlohmann::json SceneRun<G>::parameters() const {
   const auto& s = cfg_.material.steady;
   const auto& g = cfg_.material.granular;
@@ -576,6 +626,37 @@ nlohmann::json SceneRun<G>::analysis_result() const {
     a["settling_velocity_analytic"] = (1.0 - phi) * w;
     a["settling_samples"] = settle_samples_;
   }
+  if (cfg_.analysis.kind == scene::AnalysisKind::Annular && shear_frames_.size() >= 2) {
+    // S1 (scenes.md): surface v_theta/u_i at 0, 0.1, 0.2, 0.31 rad of bob rotation, distance from
+    // the Newtonian A r + B/r profile, jammed-front radius vs time and its speed, flow stop.
+    const auto geo = annular_geometry();
+    std::vector<double> angles;
+    const double max_angle = geo.bob_speed_m_per_s * shear_frames_.back().time_s / geo.bob_radius_m;
+    for (double th : {0.0, 0.1, 0.2, 0.31}) {
+      if (th <= max_angle) angles.push_back(th);
+    }
+    const auto profiles = analysis::surface_profiles(shear_frames_, geo, angles);
+    a["profiles"] = analysis::to_json(profiles);
+    nlohmann::json dist = nlohmann::json::array();
+    for (const auto& pr : profiles) dist.push_back(analysis::newtonian_distance(pr, geo));
+    a["newtonian_distance"] = dist;
+    a["bob_angle_final_rad"] = max_angle;
+    const auto fronts = analysis::jammed_front_series(shear_frames_, geo);
+    a["front"] = analysis::to_json(analysis::front_radius_series(fronts));
+    try {
+      analysis::FrontFitOptions fo;
+      fo.wall_margin_m = cfg_.grid.cell_size_m;
+      a["front_speed"] = analysis::front_speed(fronts, geo, fo).slope;
+      a["front_fit"] = analysis::to_json(analysis::front_speed(fronts, geo, fo));
+    } catch (const InputError& e) {
+      a["front_speed"] = nullptr;
+      a["front_fit_note"] = e.what();
+    }
+    // The bob keeps turning, so flow stops when the jammed front reaches the outer wall (no velocity criterion).
+    const auto stop = analysis::flow_stop_time(shear_frames_, geo, 0.0, cfg_.grid.cell_size_m);
+    a["flow_stop"] = analysis::to_json(stop);
+    a["flow_stop_time"] = stop.time_s ? nlohmann::json(*stop.time_s) : nlohmann::json(nullptr);
+  }
   if (cfg_.analysis.kind == scene::AnalysisKind::Couette && fluid_ >= 0 && NC == 3) {
     // Torque on a coaxial cylinder of radius r: M(r) = 2 pi r^2 H tau_r_theta (whole cylinder).
     // At steady state r^2 tau_r_theta is uniform in the gap (torque balance); a least-squares line
@@ -621,6 +702,9 @@ nlohmann::json SceneRun<G>::run() {
   const long every_frame = steps_between(cfg_.output.frame_interval_s, std::numeric_limits<long>::max());
   const long every_series = steps_between(cfg_.output.series_interval_s, 100);
   const long every_cp = opt_.checkpoint_every >= 0 ? opt_.checkpoint_every : cfg_.output.checkpoint_every;
+  const bool annular = cfg_.analysis.kind == scene::AnalysisKind::Annular;
+  const long every_sample = steps_between(
+      cfg_.analysis.sample_interval_s > 0 ? cfg_.analysis.sample_interval_s : cfg_.time.duration_s / 200.0, 1);
 
   std::optional<io::FrameWriter> frames;
   std::optional<io::SeriesWriter> series;
@@ -636,6 +720,7 @@ nlohmann::json SceneRun<G>::run() {
     write_frame(*frames);
     series->row(series_row());
   }
+  if (annular) sample_shear_frame();
 
   std::int64_t points = 0;
   nlohmann::json per_body;
@@ -657,6 +742,7 @@ nlohmann::json SceneRun<G>::run() {
     solver_->step();
     check_finite();
     sample_analysis();
+    if (annular && (s % every_sample == 0 || s == total_steps_)) sample_shear_frame();
     if (s % every_frame == 0 || s == total_steps_) write_frame(*frames);
     if (s % every_series == 0 || s == total_steps_) series->row(series_row());
     if (every_cp > 0 && s % every_cp == 0) write_checkpoint();

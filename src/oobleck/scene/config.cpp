@@ -383,12 +383,21 @@ SceneConfig load_scene(const std::string& path, const std::vector<std::string>& 
     o->finish();
   }
   if (auto an = top.optional_table("analysis")) {
-    constexpr std::array<std::pair<const char*, AnalysisKind>, 3> kKinds{
-        {{"none", AnalysisKind::None}, {"settling", AnalysisKind::Settling}, {"couette", AnalysisKind::Couette}}};
+    constexpr std::array<std::pair<const char*, AnalysisKind>, 4> kKinds{{{"none", AnalysisKind::None},
+                                                                          {"settling", AnalysisKind::Settling},
+                                                                          {"couette", AnalysisKind::Couette},
+                                                                          {"annular", AnalysisKind::Annular}}};
     c.analysis.kind = parse_enum(*an, "kind", AnalysisKind::None, kKinds);
     c.analysis.average_from_s = an->number_or("average_from", 0.0);
     an->require(c.analysis.average_from_s >= 0 && c.analysis.average_from_s < c.time.duration_s, "average_from",
                 c.analysis.average_from_s, "must lie in [0, time.duration) [s]");
+    c.analysis.sample_interval_s = an->number_or("sample_interval", 0.0);
+    an->require(c.analysis.sample_interval_s >= 0, "sample_interval", c.analysis.sample_interval_s, "must be >= 0 [s]");
+    if (auto z = an->optional_number("sample_z")) c.analysis.sample_z_m = *z;
+    if (c.analysis.kind == AnalysisKind::Annular &&
+        (c.grid.geometry != Geometry::Axisymmetric || c.boundary[0].type != BoundaryType::Velocity)) {
+      an->fail("kind", "\"annular\" needs an axisymmetric grid whose x_min face is a velocity wall (the bob)");
+    }
     an->finish();
   }
   top.finish();

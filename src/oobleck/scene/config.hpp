@@ -4,6 +4,7 @@
 // Every key is named with its unit in docs/scenes.md; unknown keys are errors with a suggestion.
 // This layer knows nothing of the solver; scene/build.* turns a SceneConfig into bodies.
 #include <array>
+#include <cmath>
 #include <map>
 #include <optional>
 #include <string>
@@ -89,11 +90,13 @@ struct OutputConfig {
 };
 
 /// Built-in measurement written into summary.json (scenes/verification).
-enum class AnalysisKind { None, Settling, Couette };
+enum class AnalysisKind { None, Settling, Couette, Annular };
 
 struct AnalysisConfig {
   AnalysisKind kind = AnalysisKind::None;
-  double average_from_s = 0.0;  ///< [s] start of the time average (settling)
+  double average_from_s = 0.0;   ///< [s] start of the time average (settling)
+  double sample_interval_s = 0;  ///< [s] nodal-field sampling interval (annular; 0: duration/200)
+  double sample_z_m = NAN;       ///< [m] height of the surface profile line (annular; default 2 cells below the bed top)
 };
 
 struct SceneConfig {

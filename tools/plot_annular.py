@@ -1,0 +1,43 @@
+#!/usr/bin/python3
+"""Paper Fig. 6 from an annular-shear run (scenes/paper/annular_shear.toml): surface v_theta/u_i
+profiles at the bob rotation angles in summary.json beside the Newtonian A r + B/r profile, and
+the jammed-front radius vs time.
+
+usage: plot_annular.py RUN_DIR OUT.png
+"""
+import json
+import sys
+
+from oobleck_plot import plt, save
+
+run, out = sys.argv[1], sys.argv[2]
+s = json.load(open(f"{run}/summary.json"))
+p = s["parameters"]
+ri, ro = p["r_inner"], p["r_outer"]
+A = -ri / (ro**2 - ri**2)
+B = ri * ro**2 / (ro**2 - ri**2)
+fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
+for prof, d in zip(s["profiles"], s["newtonian_distance"]):
+    r_mm = [r * 1e3 for r in prof["r"]]
+    ax1.plot(r_mm, prof["v_over_ui"], "-o", ms=2, label=f"θ = {prof['angle']:.2f} rad (dist. {d:.2f})")
+rr = [ri + (ro - ri) * k / 100 for k in range(101)]
+ax1.plot([r * 1e3 for r in rr], [A * r + B / r for r in rr], "k--", label="Newtonian A r + B/r")
+ax1.plot([r * 1e3 for r in rr], [r / ri for r in rr], "k:", lw=0.8, label="rigid rotation with the bob")
+ax1.set_xlabel("r [mm]")
+ax1.set_ylabel("surface v_θ / u_i")
+ax1.set_ylim(-0.05, max(2.0, ax1.get_ylim()[1]))
+ax1.legend(fontsize=7)
+ax1.set_title(f"u_i = {p.get('u_inner', float('nan')) * 1e3:.3g} mm/s, φ = {p['phi']}, K_0 = {p['K_0']}", fontsize=9)
+fr = s["front"]
+ax2.plot([t * 1e3 for t in fr["time"]], [r * 1e3 for r in fr["value"]], "b-")
+if s.get("front_speed") is not None:
+    fit = s["front_fit"]
+    ts = [t for t in fr["time"]]
+    ax2.plot([t * 1e3 for t in ts], [(fit["intercept"] + fit["slope"] * t) * 1e3 for t in ts], "r--",
+             label=f"fit: {s['front_speed'] * 1e3:.0f} mm/s (R² {fit['r_squared']:.3f})")
+    ax2.legend(fontsize=8)
+ax2.axhline(ro * 1e3, color="k", lw=0.8)
+ax2.set_xlabel("t [ms]")
+ax2.set_ylabel("jammed front radius [mm] (v_θ/(ω r) = 0.5)")
+ax2.set_title(f"{s['scene']}: {p['cells'][0]}×{p['cells'][1]} cells of {p['cell_size'] * 1e3:g} mm", fontsize=9)
+save(fig, out)
