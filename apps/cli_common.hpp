@@ -35,5 +35,6 @@ void add_rheology_commands(CLI::App& app);
 void add_fit_command(CLI::App& rheology);
 void add_point_commands(CLI::App& app);
 void add_run_command(CLI::App& app);
+void add_reproduce_command(CLI::App& app);
 
 }  // namespace oobleck::cli

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   oobleck::cli::add_rheology_commands(app);
   oobleck::cli::add_point_commands(app);
   oobleck::cli::add_run_command(app);
+  oobleck::cli::add_reproduce_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
