@@ -56,6 +56,13 @@ TEST(RunScenes, SettlingVelocityMatchesDragBuoyancyBalanceV4) {
   EXPECT_TRUE(fs::exists(d / "run/summary.json"));
 }
 
+TEST(RunScenes, SettlingIn3D) {
+  clitest::TempDir d;
+  const auto s = run_verification("settling_3d.toml", d / "run", {"time.duration=0.012"});
+  EXPECT_EQ(s["geometry"].get<std::string>(), "3d");
+  EXPECT_LT(rel(s["settling_velocity"].get<double>(), s["settling_velocity_analytic"].get<double>()), 0.01);
+}
+
 TEST(RunScenes, TaylorCouetteTorquesV3) {
   clitest::TempDir d;
   run::RunOptions o;
