@@ -193,16 +193,18 @@ std::vector<Case> make_loose_bed(const LooseBed& b, int n) {
 void loose_bed(benchmark::State& bs, const LooseBed& b) {
   const material::GranularLaw L = loose_bed_law(b);
   const std::vector<Case> cases = make_loose_bed(b, 4096);
-  long tension = 0, shear = 0;
+  long tension = 0, shear = 0, shear_iter = 0;
   for (const Case& c : cases) {
     material::GranularState s = c.state;
     const material::GranularUpdate u = L.update(s, c.D, c.W, b.dt, c.phi);
     shear += u.regime == material::GranularRegime::kShear ? 1 : 0;
     tension += (u.regime == material::GranularRegime::kShear && u.p_trial <= 0.0) ? 1 : 0;
+    shear_iter += u.regime == material::GranularRegime::kShear ? u.iterations : 0;
   }
   run(bs, cases, L, b.dt);
   bs.counters["shear"] = static_cast<double>(shear) / static_cast<double>(cases.size());
   bs.counters["shear_ptr_le0"] = static_cast<double>(tension) / static_cast<double>(cases.size());
+  bs.counters["shear_iterations"] = shear > 0 ? static_cast<double>(shear_iter) / static_cast<double>(shear) : 0.0;
 }
 
 // intruder bed: G = 3.8e7, K = 8.3e7 Pa, K_0 = 0.2, eta_0 = 4.6e-3 Pa s, phi = 0.47, dt = 1e-6 s

@@ -340,8 +340,65 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
       p = 0.0;
       xi1 = std::max(-p_tr / Kdt - K_3_ * phi * g, 0.0);  // E22: p = p_tr + K dt (beta g + xi_1) = 0
     } else {
-      // flow with p > 0 created by dilatancy (rare path)
-      solve_g(std::max(-p_tr / dil, 0.0), g_max);
+      // flow with p > 0 created by dilatancy (a loose bed that dilates slightly, or a stress-free
+      // dense state that is sheared). Fast path: Newton on the pair (gamma_dot, u = I_m) for the
+      // pressure balance h = Q(gamma_dot)/u^2 - p_tr - K dt gamma_dot beta(u) = 0 and E21
+      // R = tau_tr - G dt gamma_dot - (mu_q(u) + beta(u)) p - visc gamma_dot/u = 0 with p = Q/u^2,
+      // started at gamma_dot_max and the inner start of p_of (h >= 0). Accepted only when the last
+      // Newton step is below rel_tol in both unknowns and both residuals are at round-off level;
+      // otherwise (far from the root, ill-conditioned) the bracketed nested solve in gamma_dot.
+      bool fast = false;
+      {
+        double gg = g_max;
+        double uu = 0.0;
+        {
+          const double S = p_tr + dil * gg, ck = Kdt * gg;
+          uu = std::sqrt(Q_of(gg) / S);
+          if (p_tr < 0.0) uu = std::max(uu, (phi_m * ck * K_3_ / S - 1.0) / a);
+        }
+        bool step_ok = false;
+        for (int k = 1; k <= 8; ++k) {
+          ++iterations;
+          const double iu = 1.0 / uu;
+          const double Qp = 2.0 * gg * d2_rho_s_ + two_eta;
+          const double pp = Q_of(gg) * iu * iu;
+          const double iq = 1.0 / (1.0 + a * uu);
+          const double be = K_3_ * (phi - phi_m * iq), dbe = K_3_ * phi_m * a * iq * iq;
+          const double mq = mu_q(uu);
+          const double dmq = b_ == 0.0 ? 0.0 : (mu_2_ - mu_1_) * b_ / ((uu + b_) * (uu + b_));
+          const double h = pp - p_tr - Kdt * gg * be;
+          const double Rr = tau_tr - Gdt * gg - (mq + be) * pp - visc * gg * iu;
+          const double hg = Qp * iu * iu - Kdt * be, hu = -2.0 * pp * iu - Kdt * gg * dbe;
+          const double Rg = -Gdt - (mq + be) * Qp * iu * iu - visc * iu;
+          const double Ru = -(dmq + dbe) * pp + 2.0 * (mq + be) * pp * iu + visc * gg * iu * iu;
+          const double det = hg * Ru - hu * Rg;
+          if (!(std::fabs(det) > 0.0)) break;
+          const double dg = (hu * Rr - h * Ru) / det;
+          const double du = (h * Rg - hg * Rr) / det;
+          gg += dg;
+          uu += du;
+          if (!(gg > 0.0 && gg <= g_max && uu > 0.0 && std::isfinite(uu))) break;
+          if (std::fabs(dg) <= tol * gg && std::fabs(du) <= tol * uu) {
+            step_ok = true;
+            break;
+          }
+        }
+        if (step_ok) {
+          const double pp = Q_of(gg) / (uu * uu);
+          const double be = beta_of(uu);
+          const double h = pp - p_tr - Kdt * gg * be;
+          const double Rr = tau_tr - Gdt * gg - (mu_q(uu) + be) * pp - visc * gg / uu;
+          const double res = std::fabs(Rr) / tau_tr;
+          if (pp > 0.0 && be >= 0.0 && res <= 1e-10 && std::fabs(h) <= 1e-12 * (std::fabs(p_tr) + pp + Kdt * gg * be)) {
+            fast = true;
+            g = gg;
+            u = uu;
+            p = pp;
+            residual = res;
+          }
+        }
+      }
+      if (!fast) solve_g(std::max(-p_tr / dil, 0.0), g_max);
       tau = std::min(friction(g, p, u), tau_tr);
       regime = p > 0.0 ? GranularRegime::kShear : GranularRegime::kSeparated;
       if (p <= 0.0) xi1 = std::max(-p_tr / Kdt - K_3_ * phi * g, 0.0);
