@@ -1,6 +1,7 @@
 // Granular return map (model.md E16–E24) throughput on one core for a realistic mix of regimes:
 // steadily flowing points (f_1 and f_1 + f_3 active), relaxing points (compaction), jammed
 // elastic points and separated (tensile) points, at an MPM-like time step of 1e-6 s.
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -92,8 +93,8 @@ const material::GranularLaw& law_staggered() {
   return l;
 }
 
-void run(benchmark::State& bs, const std::vector<Case>& cases, const material::GranularLaw& L = law()) {
-  const double dt = 1e-6;
+void run(benchmark::State& bs, const std::vector<Case>& cases, const material::GranularLaw& L = law(),
+         double dt = 1e-6) {
   std::size_t i = 0;
   long failures = 0, implicit = 0;
   for (auto _ : bs) {
@@ -135,6 +136,84 @@ void BM_GranularUpdateFlowing(benchmark::State& bs) {
   run(bs, cases);
 }
 BENCHMARK(BM_GranularUpdateFlowing);
+
+// States of a loose bed nearly at rest, as in bench/scenes/{intruder,wheel}_authors_setup.toml:
+// phi = 0.47/0.482 < phi_m, f ~ 0, tiny stresses (p, tau_bar 1e-12..1e-2 Pa) and small strain
+// rates (1e-5..1e-2 1/s, dilating or compacting: p_tr of either sign), so every point is in the
+// shear (mostly p_tr <= 0: pressure created by dilatancy) or the shear+compaction regime.
+struct LooseBed {
+  double G, K, K_0, eta_0, phi, dt;
+};
+
+material::GranularLaw loose_bed_law(const LooseBed& b) {
+  rheology::Preset P = rheology::load_preset("hermes2016");
+  P.granular.G = b.G;
+  P.granular.K = b.K;
+  P.granular.K_0 = b.K_0;
+  P.steady.eta_0 = b.eta_0;
+  return material::GranularLaw(P);
+}
+
+std::vector<Case> make_loose_bed(const LooseBed& b, int n) {
+  std::mt19937_64 rng(2024);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  std::normal_distribution<double> N(0.0, 1.0);
+  auto log_uniform = [&](double lo, double hi) { return std::exp(std::log(lo) + (std::log(hi) - std::log(lo)) * U(rng)); };
+  auto random_sym = [&] {
+    Eigen::Matrix3d m;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) m(i, j) = N(rng);
+    return Eigen::Matrix3d(0.5 * (m + m.transpose()));
+  };
+  std::vector<Case> out;
+  for (int k = 0; k < n; ++k) {
+    Case c;
+    c.phi = b.phi;
+    c.state.f = U(rng) < 0.2 ? 0.0 : log_uniform(1e-22, 1e-11);
+    const double p0 = log_uniform(1e-12, 1e-2);
+    Eigen::Matrix3d s = random_sym();
+    s.diagonal().array() -= s.trace() / 3.0;
+    c.state.sigma = std::sqrt(2.0) * (0.5 + 2.5 * U(rng)) * p0 * s / s.norm();
+    c.state.sigma.diagonal().array() -= p0;
+    const double rate = log_uniform(1e-5, 1e-2);
+    // mostly uniaxial (settling bed): +-rate n n^T (60 % dilating: p_tr < 0) plus a smaller random part
+    Eigen::Vector3d nv(N(rng), N(rng), N(rng));
+    nv.normalize();
+    const Eigen::Matrix3d R = random_sym();
+    c.D = rate * ((U(rng) < 0.6 ? 1.0 : -1.0) * nv * nv.transpose() + 0.3 * R / R.norm());
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    A(0, 1) = N(rng);
+    A(1, 0) = -A(0, 1);
+    c.W = 0.5 * rate * A;
+    out.push_back(c);
+  }
+  return out;
+}
+
+void loose_bed(benchmark::State& bs, const LooseBed& b) {
+  const material::GranularLaw L = loose_bed_law(b);
+  const std::vector<Case> cases = make_loose_bed(b, 4096);
+  long tension = 0, shear = 0, shear_iter = 0;
+  for (const Case& c : cases) {
+    material::GranularState s = c.state;
+    const material::GranularUpdate u = L.update(s, c.D, c.W, b.dt, c.phi);
+    shear += u.regime == material::GranularRegime::kShear ? 1 : 0;
+    tension += (u.regime == material::GranularRegime::kShear && u.p_trial <= 0.0) ? 1 : 0;
+    shear_iter += u.regime == material::GranularRegime::kShear ? u.iterations : 0;
+  }
+  run(bs, cases, L, b.dt);
+  bs.counters["shear"] = static_cast<double>(shear) / static_cast<double>(cases.size());
+  bs.counters["shear_ptr_le0"] = static_cast<double>(tension) / static_cast<double>(cases.size());
+  bs.counters["shear_iterations"] = shear > 0 ? static_cast<double>(shear_iter) / static_cast<double>(shear) : 0.0;
+}
+
+// intruder bed: G = 3.8e7, K = 8.3e7 Pa, K_0 = 0.2, eta_0 = 4.6e-3 Pa s, phi = 0.47, dt = 1e-6 s
+void BM_GranularUpdateLooseBedIntruder(benchmark::State& bs) { loose_bed(bs, {3.8e7, 8.3e7, 0.2, 4.6e-3, 0.47, 1e-6}); }
+BENCHMARK(BM_GranularUpdateLooseBedIntruder);
+
+// wheel bed: G = 3.8e5, K = 8.3e5 Pa, K_0 = 1, eta_0 = 1e-3 Pa s, phi = 0.482, dt = 2e-5 s
+void BM_GranularUpdateLooseBedWheel(benchmark::State& bs) { loose_bed(bs, {3.8e5, 8.3e5, 1.0, 1e-3, 0.482, 2e-5}); }
+BENCHMARK(BM_GranularUpdateLooseBedWheel);
 
 }  // namespace
 

@@ -118,75 +118,93 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
   };
 
   // ---- General shear solve in gamma_dot (used for p_tr <= 0 and as the fallback of the fast path).
-  // Inner: for fixed gamma_dot the pressure balance R_a(p) = p - p_tr - K dt gamma_dot beta(I_m(gamma_dot, p))
-  // is strictly increasing in p (beta decreases with p), root in (0, p_tr + K dt K_3 phi gamma_dot].
-  auto p_of = [&](double gg, double& uu, bool& ok) -> double {
-    ok = true;
+  // Inner: for fixed gamma_dot the pressure balance, written in u = I_m with p = Q(gamma_dot)/u^2,
+  // h(u) = Q/u^2 - p_tr - K dt gamma_dot beta(u), is strictly decreasing and convex in u (Q/u^2 and
+  // -beta(u) are). Newton started left of the root (h >= 0) therefore increases monotonically to it
+  // without overshooting. Start: the larger of u at p = p_tr + K dt K_3 phi gamma_dot (the largest
+  // possible p) and, for p_tr < 0, the u at which p_tr + K dt gamma_dot beta(u) = 0 (p -> 0+); both
+  // have h >= 0. Also returns du/dgamma_dot (implicit derivative) for the outer Newton.
+  struct Inner {
+    double p, u, du, dp;  // p, I_m and their derivatives in gamma_dot
+    bool ok;
+  };
+  auto p_of = [&](double gg) -> Inner {
+    Inner in{0.0, kInf, 0.0, 0.0, true};
     if (!(gg > 0.0)) {
-      uu = 0.0;
-      return std::max(p_tr, 0.0);
+      in.u = 0.0;
+      in.p = std::max(p_tr, 0.0);
+      return in;
     }
-    if (p_tr + dil * gg <= 0.0) {  // no contact pressure even with full dilatancy
-      uu = kInf;
-      return 0.0;
-    }
+    const double S = p_tr + dil * gg;  // p at beta = K_3 phi (u -> infinity): the largest possible p
+    if (S <= 0.0) return in;            // no contact pressure even with full dilatancy
     const double Q = Q_of(gg), ck = Kdt * gg;
-    double plo = 0.0, phigh = p_tr + dil * gg, x = phigh;
-    ok = false;
+    double x = std::sqrt(Q / S);
+    if (p_tr < 0.0) {
+      const double u0 = (phi_m * ck * K_3_ / S - 1.0) / a;  // beta(u0) = -p_tr/(K dt gamma_dot)
+      if (u0 > x) x = u0;
+    }
+    in.ok = false;
     for (int k = 1; k <= cap; ++k) {
       ++iterations;
-      const double um = std::sqrt(Q / x);
-      const double Ra = x - p_tr - ck * beta_of(um);
-      if (std::fabs(Ra) <= 1e-15 * (x + std::fabs(p_tr))) {
-        ok = true;
+      const double hv = Q / (x * x) - p_tr - ck * beta_of(x);
+      if (hv <= 0.0) {  // at the root (or past it by round-off)
+        in.ok = true;
         break;
       }
-      const double dRa = 1.0 + ck * dbeta_of(um) * um / (2.0 * x);
-      if (Ra > 0.0) phigh = x; else plo = x;
-      double nx = x - Ra / dRa;
-      const bool newton = nx > plo && nx < phigh;
-      if (!newton) nx = 0.5 * (plo + phigh);
-      if ((newton && std::fabs(nx - x) <= tol * x) || (phigh - plo) <= tol * phigh) {
-        x = nx;
-        ok = true;
+      const double dh = -2.0 * Q / (x * x * x) - ck * dbeta_of(x);
+      const double step = -hv / dh;
+      x += step;
+      if (!(step > 0.25 * tol * x)) {
+        in.ok = std::isfinite(x);
         break;
       }
-      x = nx;
     }
-    uu = std::sqrt(Q / x);
-    return x;
+    in.u = x;
+    in.p = Q / (x * x);
+    // implicit derivatives: h(u(g), g) = 0
+    const double Qp = 2.0 * gg * d2_rho_s_ + two_eta;
+    const double hu = -2.0 * in.p / x - ck * dbeta_of(x);
+    const double hg = Qp / (x * x) - Kdt * beta_of(x);
+    in.du = hu < 0.0 ? -hg / hu : 0.0;
+    in.dp = Qp / (x * x) - 2.0 * in.p / x * in.du;
+    return in;
   };
-  // Outer: R(gamma_dot) = tau_tr - G dt gamma_dot - friction, R(glo) > 0 >= R(ghi); Illinois.
+  // Outer: R(gamma_dot) = tau_tr - G dt gamma_dot - friction on [glo, ghi] with R(glo) > 0 >= R(ghi):
+  // Newton with the analytic dR/dgamma_dot, started at ghi and kept inside the shrinking bracket
+  // (bisection when a step leaves it).
   auto solve_g = [&](double glo, double ghi) {
-    bool ok_in = true, all_ok = true;
+    bool all_ok = true;
     double pp = 0.0, uu = 0.0;
-    auto R_g = [&](double gg) {
-      pp = p_of(gg, uu, ok_in);
-      all_ok = all_ok && ok_in;
-      return tau_tr - Gdt * gg - friction(gg, pp, uu);
+    auto R_g = [&](double gg, double& dR) {
+      const Inner in = p_of(gg);
+      all_ok = all_ok && in.ok;
+      pp = in.p;
+      uu = in.u;
+      double F = 0.0, dF = 0.0;
+      if (in.p > 0.0 && in.u > 0.0 && std::isfinite(in.u)) {
+        const double be = beta_of(in.u), dbe = dbeta_of(in.u);
+        const double mq = mu_q(in.u);
+        const double dmq = b_ == 0.0 ? 0.0 : (mu_2_ - mu_1_) * b_ / ((in.u + b_) * (in.u + b_));
+        F = (mq + be) * in.p + visc * gg / in.u;
+        dF = (dmq + dbe) * in.du * in.p + (mq + be) * in.dp + visc / in.u - visc * gg / (in.u * in.u) * in.du;
+        if (F < 0.0) F = dF = 0.0;
+      }
+      dR = -Gdt - dF;
+      return tau_tr - Gdt * gg - F;
     };
-    double Rlo = R_g(glo), Rhi = R_g(ghi);
-    double gg = ghi, R = Rhi;
-    bool done = false;
-    int side = 0;
+    double gg = ghi, dR = 0.0;
+    double R = R_g(gg, dR);
+    bool done = std::fabs(R) <= 1e-14 * tau_tr;
     for (int k = 1; k <= cap && !done; ++k) {
       ++iterations;
-      gg = (Rlo - Rhi) > 0.0 ? (glo * Rhi - ghi * Rlo) / (Rhi - Rlo) : 0.5 * (glo + ghi);
-      if (!(gg > glo && gg < ghi)) gg = 0.5 * (glo + ghi);
-      R = R_g(gg);
-      if (std::fabs(R) <= 1e-14 * tau_tr) break;
-      if (R > 0.0) {
-        glo = gg;
-        Rlo = R;
-        if (side == 1) Rhi *= 0.5;
-        side = 1;
-      } else {
-        ghi = gg;
-        Rhi = R;
-        if (side == -1) Rlo *= 0.5;
-        side = -1;
-      }
-      done = (ghi - glo) <= tol * ghi;
+      if (R > 0.0) glo = gg; else ghi = gg;
+      double next = dR < 0.0 ? gg - R / dR : -1.0;
+      const bool newton = next > glo && next < ghi;
+      if (!newton) next = 0.5 * (glo + ghi);
+      done = (newton && std::fabs(next - gg) <= tol * gg) || (ghi - glo) <= tol * ghi;
+      gg = next;
+      R = R_g(gg, dR);
+      done = done || std::fabs(R) <= 1e-14 * tau_tr;
     }
     g = gg;
     p = pp;
@@ -322,8 +340,75 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
       p = 0.0;
       xi1 = std::max(-p_tr / Kdt - K_3_ * phi * g, 0.0);  // E22: p = p_tr + K dt (beta g + xi_1) = 0
     } else {
-      // flow with p > 0 created by dilatancy (rare path)
-      solve_g(std::max(-p_tr / dil, 0.0), g_max);
+      // flow with p > 0 created by dilatancy (a loose bed that dilates slightly, or a stress-free
+      // dense state that is sheared). Fast path: Newton on the pair (gamma_dot, u = I_m) for the
+      // pressure balance h = Q(gamma_dot)/u^2 - p_tr - K dt gamma_dot beta(u) = 0 and E21
+      // R = tau_tr - G dt gamma_dot - (mu_q(u) + beta(u)) p - visc gamma_dot/u = 0 with p = Q/u^2,
+      // started at gamma_dot_max and the inner start of p_of (h >= 0). Accepted only when the last
+      // Newton step is below rel_tol in both unknowns and both residuals are at round-off level;
+      // otherwise (far from the root, ill-conditioned) the bracketed nested solve in gamma_dot.
+      bool fast = false;
+      {
+        double gg = g_max;
+        double uu = 0.0;
+        {
+          const double S = p_tr + dil * gg, ck = Kdt * gg;
+          uu = std::sqrt(Q_of(gg) / S);
+          if (p_tr < 0.0) uu = std::max(uu, (phi_m * ck * K_3_ / S - 1.0) / a);
+        }
+        bool step_ok = false;
+        for (int k = 1; k <= 8; ++k) {
+          ++iterations;
+          const double iu = 1.0 / uu;
+          const double Qp = 2.0 * gg * d2_rho_s_ + two_eta;
+          const double pp = Q_of(gg) * iu * iu;
+          const double iq = 1.0 / (1.0 + a * uu);
+          const double be = K_3_ * (phi - phi_m * iq), dbe = K_3_ * phi_m * a * iq * iq;
+          const double mq = mu_q(uu);
+          const double dmq = b_ == 0.0 ? 0.0 : (mu_2_ - mu_1_) * b_ / ((uu + b_) * (uu + b_));
+          const double h = pp - p_tr - Kdt * gg * be;
+          const double Rr = tau_tr - Gdt * gg - (mq + be) * pp - visc * gg * iu;
+          // residual exit with the tolerances of the nested solve (|R| <= 1e-14 tau_tr, pressure
+          // balance to 1e-15 of its terms)
+          if (std::fabs(Rr) <= 1e-14 * tau_tr && std::fabs(h) <= 1e-15 * (std::fabs(p_tr) + pp) && be >= 0.0) {
+            fast = true;
+            g = gg;
+            u = uu;
+            p = pp;
+            residual = std::fabs(Rr) / tau_tr;
+            break;
+          }
+          const double hg = Qp * iu * iu - Kdt * be, hu = -2.0 * pp * iu - Kdt * gg * dbe;
+          const double Rg = -Gdt - (mq + be) * Qp * iu * iu - visc * iu;
+          const double Ru = -(dmq + dbe) * pp + 2.0 * (mq + be) * pp * iu + visc * gg * iu * iu;
+          const double det = hg * Ru - hu * Rg;
+          if (!(std::fabs(det) > 0.0)) break;
+          const double dg = (hu * Rr - h * Ru) / det;
+          const double du = (h * Rg - hg * Rr) / det;
+          gg += dg;
+          uu += du;
+          if (!(gg > 0.0 && gg <= g_max && uu > 0.0 && std::isfinite(uu))) break;
+          if (std::fabs(dg) <= tol * gg && std::fabs(du) <= tol * uu) {
+            step_ok = true;
+            break;
+          }
+        }
+        if (step_ok && !fast) {
+          const double pp = Q_of(gg) / (uu * uu);
+          const double be = beta_of(uu);
+          const double h = pp - p_tr - Kdt * gg * be;
+          const double Rr = tau_tr - Gdt * gg - (mu_q(uu) + be) * pp - visc * gg / uu;
+          const double res = std::fabs(Rr) / tau_tr;
+          if (pp > 0.0 && be >= 0.0 && res <= 1e-10 && std::fabs(h) <= 1e-12 * (std::fabs(p_tr) + pp + Kdt * gg * be)) {
+            fast = true;
+            g = gg;
+            u = uu;
+            p = pp;
+            residual = res;
+          }
+        }
+      }
+      if (!fast) solve_g(std::max(-p_tr / dil, 0.0), g_max);
       tau = std::min(friction(g, p, u), tau_tr);
       regime = p > 0.0 ? GranularRegime::kShear : GranularRegime::kSeparated;
       if (p <= 0.0) xi1 = std::max(-p_tr / Kdt - K_3_ * phi * g, 0.0);
