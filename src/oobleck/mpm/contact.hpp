@@ -10,8 +10,15 @@
 // * Elastic bodies are Solid bodies with any law (LinearElasticLaw): the contact impulses change
 //   their nodal velocities like any other force; a `Motor` holds their mean angular velocity.
 // * Contact (model.md §8) at every node where the solid and the mixture (grains and/or fluid) both
-//   have mass: outward normal n = −∇m_b/|∇m_b| from the solid's nodal mass gradient
-//   ∇m_b,i = Σ_p m_p ∇N_ip. Only phases that approach the solid, (v_k − v_b)·n < 0, are touched:
+//   have mass *and their nodal volumes overlap*: Σ_p N_ip V_p summed over the solid's and the
+//   mixture's points is ≥ θ V_node (θ = `overlap_threshold`, 0.98; V_node = h^D, per radian h² r).
+//   By the partition of unity two bodies that exactly touch fill every node's volume (sum = 1),
+//   a gap leaves it below 1, and at a corner next to empty space it is well below 1. The pure
+//   "both have mass" rule of model.md §8 (θ = 0) acts up to a cell early at every edge (see
+//   docs/contact.md for what it does to a sliding block). The outward normal of the solid is
+//   n = ∇m_b/|∇m_b| with ∇m_b,i = Σ_p m_p ∇N_i(x_p) (at a node outside the body every ∇N_i(x_p)
+//   points from the body's points towards the node: outward). Only phases that approach the
+//   solid, (v_k − v_b)·n < 0, are touched:
 //     both grains and fluid approach: the three share the mass-weighted normal velocity
 //       v_n* = (m_b v_b·n + m_s v_s·n + m_f v_f·n)/(m_b + m_s + m_f)        (three-body)
 //     one phase k approaches:  v_n* = (m_b v_b·n + m_k v_k·n)/(m_b + m_k)   (two-body)
@@ -74,8 +81,13 @@ struct ContactPair {
   Vec<NC> force_N = Vec<NC>::Zero();       ///< contact force on the solid, last step [N]
   Vec<NC> force_on_grains_N = Vec<NC>::Zero();  ///< part of −force_N acting on the grains [N]
   Vec<NC> impulse_sum_N_s = Vec<NC>::Zero();    ///< Σ over all steps of the impulse on the solid
+  /// Contact detection (see header): a node is a contact candidate where both have mass and the
+  /// nodal volumes overlap, (V_b,i + V_mix,i) ≥ overlap_threshold · V_node,i. 0 disables the
+  /// volume test (contact wherever both have mass, model.md §8 literally).
+  double overlap_threshold = 0.98;
   int active_nodes = 0;                    ///< nodes where an impulse acted, last step
   std::vector<Vec<G::dim>> mass_gradient;  ///< nodal ∇m_b (sized once)
+  std::vector<double> volume_m3;           ///< nodal volume Σ N_ip V_p of the solid (sized once)
 };
 
 /// Velocity-level motor (model.md §8, wheel): before each step, the mean angular velocity of the
@@ -186,15 +198,23 @@ void predict_rigid(RigidMotion<G>& rm, const Body<G>& body, GridField<G>& field,
   }
 }
 
-/// Nodal mass gradient ∇m_b,i = Σ_p m_p ∇N_ip of a body (its shape cache of the step).
+/// Nodal mass gradient ∇m_b,i = Σ_p m_p ∇N_ip and nodal volume Σ_p N_ip V_p of a body (its
+/// shape cache of the step); `grad` may be null (volume only).
 template <class G, int K>
-void compute_mass_gradient(const Body<G>& body, const ShapeCache<G::dim>& cache, std::vector<Vec<G::dim>>& grad) {
-  for (auto& g : grad) g.setZero();
+void scatter_mass_gradient_and_volume(const Body<G>& body, const ShapeCache<G::dim>& cache,
+                                      std::vector<Vec<G::dim>>* grad, std::vector<double>& volume) {
+  if (grad)
+    for (auto& g : *grad) g.setZero();
+  std::fill(volume.begin(), volume.end(), 0.0);
   const std::int64_t np = body.size();
   for (std::int64_t p = 0; p < np; ++p) {
-    const double m = body.mass_kg[p];
+    const double m = body.mass_kg[p], V = body.volume_m3[p];
     const std::int64_t o = p * K;
-    for (int k = 0; k < K; ++k) grad[cache.node[o + k]] += m * cache.grad[o + k];
+    for (int k = 0; k < K; ++k) {
+      const int i = cache.node[o + k];
+      if (grad) (*grad)[i] += m * cache.grad[o + k];
+      volume[i] += cache.w[o + k] * V;
+    }
   }
 }
 
@@ -277,6 +297,12 @@ std::vector<double> contact_node_weights(const Grid<D>& grid, const BoundaryCond
 }
 }  // namespace detail
 
+/// Volume of node i's control volume h^D (per radian: h² r_i) for the overlap test.
+template <class G>
+double node_measure(const Grid<G::dim>& grid, int i) {
+  return G::measure(grid.node_position(i), grid.cell_volume());
+}
+
 /// Resolve one contact pair at every node (model.md §8): impulses applied to the nodal velocities
 /// of the grains, the fluid and a deformable solid (a rigid one only accumulates them), summed
 /// with the node weights into pair.force_N. Serial over nodes (deterministic sums; the solid
@@ -284,6 +310,7 @@ std::vector<double> contact_node_weights(const Grid<D>& grid, const BoundaryCond
 template <class G>
 Vec<G::ncomp> resolve_contact(ContactPair<G>& pair, const RigidMotion<G>& rm, GridField<G>& solid,
                               GridField<G>* grains, GridField<G>* fluid, const std::vector<double>& weight,
+                              const double* mixture_volume, const std::vector<double>& node_volume,
                               double dt_s) {
   constexpr int NC = G::ncomp, D = G::dim;
   Vec<NC> J_body = Vec<NC>::Zero(), J_grains = Vec<NC>::Zero();
@@ -297,11 +324,14 @@ Vec<G::ncomp> resolve_contact(ContactPair<G>& pair, const RigidMotion<G>& rm, Gr
     if (!(mb > 0.0) || weight[i] == 0.0) continue;
     const double ms = grains ? grains->mass_kg[i] : 0.0, mf = fluid ? fluid->mass_kg[i] : 0.0;
     if (!(ms > 0.0) && !(mf > 0.0)) continue;
+    if (pair.overlap_threshold > 0.0 &&
+        pair.volume_m3[i] + mixture_volume[i] < pair.overlap_threshold * node_volume[i])
+      continue;  // both have mass, but their smoothed volumes leave a gap: not touching
     const Vec<D>& g = pair.mass_gradient[i];
     const double gn = g.norm();
     if (!(gn > 0.0)) continue;
     Vec<NC> n = Vec<NC>::Zero();
-    n.template head<D>() = -g / gn;
+    n.template head<D>() = g / gn;  // Σ m_p ∇N_i(x_p) points away from the body at its boundary
     Vec<NC> Js, Jf;
     if (!contact_impulses<NC>(n, prescribed ? INFINITY : mb, solid.velocity[i], ms,
                               ms > 0.0 ? grains->velocity[i] : zero, mf,

@@ -144,6 +144,7 @@ class Solver {
     contacts_.back().solid = b;
     contacts_.back().friction_coefficient = friction_coefficient;
     contacts_.back().mass_gradient.assign(static_cast<std::size_t>(grid_.node_count()), Vec<D>::Zero());
+    contacts_.back().volume_m3.assign(static_cast<std::size_t>(grid_.node_count()), 0.0);
     return static_cast<int>(contacts_.size()) - 1;
   }
   const ContactPair<G>& contact(int pair) const { return contacts_[pair]; }
@@ -354,14 +355,29 @@ class Solver {
       for (auto& rm : rigid_) rm.velocity_m_s = rm.predicted_m_s;
       return;
     }
-    if (contact_weight_.empty()) contact_weight_ = detail::contact_node_weights<D>(grid_, bc_);
+    if (contact_weight_.empty()) {  // once: node weights and measures (boundaries are set by now)
+      contact_weight_ = detail::contact_node_weights<D>(grid_, bc_);
+      node_measure_.resize(contact_weight_.size());
+      for (int i = 0; i < grid_.node_count(); ++i) node_measure_[i] = node_measure<G>(grid_, i);
+    }
     GridField<G>* grains = grains_ >= 0 ? &fields_[grains_] : nullptr;
     GridField<G>* fluid = fluid_ >= 0 ? &fields_[fluid_] : nullptr;
+    // Nodal mixture volume Σ N V_p: the fluid's (its points carry the mixture volume), else the
+    // grains' (scattered here; fluid-free beds).
+    const double* mixture_volume = nullptr;
+    if (fluid) {
+      mixture_volume = fluid->volume_m3.data();
+    } else if (grains) {
+      mixture_volume_.resize(contact_weight_.size());
+      scatter_mass_gradient_and_volume<G, K>(*bodies_[grains_], caches_[grains_], nullptr, mixture_volume_);
+      mixture_volume = mixture_volume_.data();
+    }
     for (auto& rm : rigid_) rm.velocity_m_s = rm.predicted_m_s;
     for (auto& c : contacts_) {
-      compute_mass_gradient<G, K>(*bodies_[c.solid], caches_[c.solid], c.mass_gradient);
+      scatter_mass_gradient_and_volume<G, K>(*bodies_[c.solid], caches_[c.solid], &c.mass_gradient, c.volume_m3);
       RigidMotion<G>& rm = rigid_[c.solid];
-      const Vec<NC> J = resolve_contact(c, rm, fields_[c.solid], grains, fluid, contact_weight_, opt_.dt_s);
+      const Vec<NC> J = resolve_contact(c, rm, fields_[c.solid], grains, fluid, contact_weight_, mixture_volume,
+                                        node_measure_, opt_.dt_s);
       if (rm.kind == BodyMotion::FreeRigid && rm.mass_kg > 0.0)
         rm.velocity_m_s += J.cwiseProduct(rm.free_mask) / rm.mass_kg;
     }
@@ -441,6 +457,8 @@ class Solver {
   std::vector<ContactPair<G>> contacts_;   ///< solid–mixture contact pairs (§8)
   std::vector<Motor<G>> motors_;           ///< angular-velocity motors (§8, wheel)
   std::vector<double> contact_weight_;     ///< per node: weight in the body impulse sums
+  std::vector<double> node_measure_;       ///< per node: h^D (per radian h² r) for the overlap test
+  std::vector<double> mixture_volume_;     ///< nodal grains volume when there is no fluid body
   std::vector<ShapeCache<D>> caches_;
   std::vector<GridField<G>> fields_;
   int threads_ = 1;
