@@ -85,6 +85,12 @@ struct ContactPair {
   /// nodal volumes overlap, (V_b,i + V_mix,i) ≥ overlap_threshold · V_node,i. 0 disables the
   /// volume test (contact wherever both have mass, model.md §8 literally).
   double overlap_threshold = 0.98;
+  /// Normal from the solid's mass gradient alone (false), or the combined normal of the pair
+  /// n = (∇m_b − ∇m_mix)/|∇m_b − ∇m_mix| (true, default; the mixture's mass gradient from its
+  /// grains, or its fluid when there are no grains; costs one serial scatter over the mixture's
+  /// points per step). Sliding block (docs/contact.md): horizontal/normal force 0.317 with the
+  /// combined normal vs 0.337 with the solid's alone, for μ = 0.3 at 32 cells/m.
+  bool combined_normal = true;
   int active_nodes = 0;                    ///< nodes where an impulse acted, last step
   std::vector<Vec<G::dim>> mass_gradient;  ///< nodal ∇m_b (sized once)
   std::vector<double> volume_m3;           ///< nodal volume Σ N_ip V_p of the solid (sized once)
@@ -311,7 +317,7 @@ template <class G>
 Vec<G::ncomp> resolve_contact(ContactPair<G>& pair, const RigidMotion<G>& rm, GridField<G>& solid,
                               GridField<G>* grains, GridField<G>* fluid, const std::vector<double>& weight,
                               const double* mixture_volume, const std::vector<double>& node_volume,
-                              double dt_s) {
+                              const Vec<G::dim>* mixture_gradient, double dt_s) {
   constexpr int NC = G::ncomp, D = G::dim;
   Vec<NC> J_body = Vec<NC>::Zero(), J_grains = Vec<NC>::Zero();
   int active = 0;
@@ -327,7 +333,8 @@ Vec<G::ncomp> resolve_contact(ContactPair<G>& pair, const RigidMotion<G>& rm, Gr
     if (pair.overlap_threshold > 0.0 &&
         pair.volume_m3[i] + mixture_volume[i] < pair.overlap_threshold * node_volume[i])
       continue;  // both have mass, but their smoothed volumes leave a gap: not touching
-    const Vec<D>& g = pair.mass_gradient[i];
+    Vec<D> g = pair.mass_gradient[i];
+    if (mixture_gradient) g -= mixture_gradient[i];
     const double gn = g.norm();
     if (!(gn > 0.0)) continue;
     Vec<NC> n = Vec<NC>::Zero();

@@ -365,19 +365,24 @@ class Solver {
     // Nodal mixture volume Σ N V_p: the fluid's (its points carry the mixture volume), else the
     // grains' (scattered here; fluid-free beds).
     const double* mixture_volume = nullptr;
-    if (fluid) {
-      mixture_volume = fluid->volume_m3.data();
-    } else if (grains) {
+    bool combined = false;
+    for (const auto& c : contacts_) combined = combined || c.combined_normal;
+    const int mix = grains_ >= 0 ? grains_ : fluid_;
+    if (mix >= 0 && (combined || !fluid)) {  // mixture mass gradient and/or volume
       mixture_volume_.resize(contact_weight_.size());
-      scatter_mass_gradient_and_volume<G, K>(*bodies_[grains_], caches_[grains_], nullptr, mixture_volume_);
+      mixture_gradient_.resize(contact_weight_.size());
+      scatter_mass_gradient_and_volume<G, K>(*bodies_[mix], caches_[mix], combined ? &mixture_gradient_ : nullptr,
+                                             mixture_volume_);
       mixture_volume = mixture_volume_.data();
     }
+    if (fluid) mixture_volume = fluid->volume_m3.data();  // folded at walls, the same points' volumes
     for (auto& rm : rigid_) rm.velocity_m_s = rm.predicted_m_s;
     for (auto& c : contacts_) {
       scatter_mass_gradient_and_volume<G, K>(*bodies_[c.solid], caches_[c.solid], &c.mass_gradient, c.volume_m3);
       RigidMotion<G>& rm = rigid_[c.solid];
       const Vec<NC> J = resolve_contact(c, rm, fields_[c.solid], grains, fluid, contact_weight_, mixture_volume,
-                                        node_measure_, opt_.dt_s);
+                                        node_measure_, c.combined_normal ? mixture_gradient_.data() : nullptr,
+                                        opt_.dt_s);
       if (rm.kind == BodyMotion::FreeRigid && rm.mass_kg > 0.0)
         rm.velocity_m_s += J.cwiseProduct(rm.free_mask) / rm.mass_kg;
     }
@@ -459,6 +464,7 @@ class Solver {
   std::vector<double> contact_weight_;     ///< per node: weight in the body impulse sums
   std::vector<double> node_measure_;       ///< per node: h^D (per radian h² r) for the overlap test
   std::vector<double> mixture_volume_;     ///< nodal grains volume when there is no fluid body
+  std::vector<Vec<D>> mixture_gradient_;   ///< nodal mixture mass gradient (combined normals)
   std::vector<ShapeCache<D>> caches_;
   std::vector<GridField<G>> fields_;
   int threads_ = 1;
