@@ -364,3 +364,78 @@ TEST(Contact, MotorHoldsMeanAngularVelocityOfFreeElasticWheel) {
   EXPECT_GT(s.motor(m).inertia_kg_m2, 0.0);
   (void)M;
 }
+
+// ---- free rod dropped onto a fluid: Archimedes ---------------------------------------------------
+
+TEST(Contact, FreeRodDroppedOntoFluidFloatsAtArchimedesDraft) {
+  // Axisymmetric: a rigid rod (radius R, length L, ρ_b = ρ_f/4) released at rest with its flat end
+  // on the free surface of a viscous fluid in a cylinder (radius R_c, depth D; axis, slip wall
+  // and floor; the fluid starts hydrostatic). It must come to float with the draft
+  // d = L ρ_b/ρ_f (Archimedes: ρ_f g d πR² = ρ_b g L πR²); the displaced fluid raises the level to
+  // D + (R/R_c)² d (incompressible), so the rod's centre ends at D + (R/R_c)² d − d + L/2, and the
+  // mean contact force equals its weight. (Released at the surface it overshoots to ≈ 2d; the
+  // freeboard L − 2d keeps the fluid from washing over its top.) Only the fluid's pressure carries the rod (no grains:
+  // the contact is two-body, rod–fluid, and the fluid slips along the rod's side).
+  const double h = 1e-3, g = 9.81, rho_f = 1000.0, rho_b = 250.0;
+  const double Rc = 16 * h, D = 16 * h, R = 4 * h, L = 20 * h;
+  Grid<2> grid(Vec<2>(0.0, 0.0), h, {16, 40});
+  SolverOptions<Axisymmetric> opt;
+  opt.threads = 1;
+  opt.gravity_m_s2 = Vec<3>(0.0, -g, 0.0);
+  opt.mixture.rho_f0_kg_m3 = rho_f;
+  Solver<Axisymmetric> s(grid, opt);
+  s.boundaries()[0].type = WallType::Axis;
+  s.boundaries()[1].type = WallType::Slip;
+  s.boundaries()[2].type = WallType::Slip;
+  auto& fluid = s.add_body("fluid", Phase::Fluid);
+  FluidParams fp;
+  fp.kappa_Pa = 4e4;      // c = 6.3 m/s; hydrostatic strain ρ g D/κ = 0.4%
+  fp.eta_0_Pa_s = 0.05;   // damps the rod's heave (period 2π √(d/g) ≈ 0.14 s)
+  fp.rho_f0_kg_m3 = rho_f;
+  auto law = std::make_unique<FluidLaw<Axisymmetric>>(fp, opt.mixture.min_porosity);
+  auto* fl = law.get();
+  fluid.set_law(std::move(law));
+  fill_box(fluid, Vec<2>(0.0, 0.0), Vec<2>(Rc, D), h, 2, rho_f, [](const Vec<2>&) { return Vec<3>::Zero(); });
+  for (std::int64_t p = 0; p < fluid.size(); ++p) {  // hydrostatic start: p = ρ g (D − z)
+    const double pr = rho_f * g * (D - fluid.x_m[p][1]);
+    fl->J[p] = std::exp(-pr / fp.kappa_Pa);
+    fluid.stress_Pa[p] = -pr * Mat3::Identity();
+  }
+  auto& rod = s.add_body("rod");
+  fill_box(rod, Vec<2>(0.0, D), Vec<2>(R, D + L), h, 2, rho_b, [](const Vec<2>&) { return Vec<3>::Zero(); });
+  s.set_free_rigid(1, Vec<3>::Zero());
+  const int pr = s.add_contact(1, 0.0);
+  if (getenv("COMB0")) const_cast<ContactPair<Axisymmetric>&>(s.contact(pr)).combined_normal = false;
+  if (getenv("THETA")) const_cast<ContactPair<Axisymmetric>&>(s.contact(pr)).overlap_threshold = atof(getenv("THETA"));
+  s.options().dt_s = s.stable_dt(0.3);
+  const double M = rod.total_mass();
+  const double d = L * rho_b / rho_f;
+  const double zc_ref = D + (R / Rc) * (R / Rc) * d - d + L / 2;
+  double zsum = 0.0, fsum = 0.0, tsum = 0.0;
+  while (s.time_s() < 0.6) {
+    s.step();
+    if (s.time_s() > 0.3) {
+      double zc = 0.0;
+      for (std::int64_t p = 0; p < rod.size(); ++p) zc += rod.mass_kg[p] * rod.x_m[p][1];
+      zsum += zc / M * s.options().dt_s;
+      fsum += s.contact_force(1)[1] * s.options().dt_s;
+      tsum += s.options().dt_s;
+    }
+  }
+  const double zc = zsum / tsum, F = fsum / tsum;
+  {
+    double zb = 1e9, zt = -1e9, ztop_far = -1e9, ztop_near = -1e9;
+    int inside = 0;
+    for (const auto& x : rod.x_m) { zb = std::min(zb, x[1]); zt = std::max(zt, x[1]); }
+    for (const auto& x : fluid.x_m) {
+      if (x[0] < R && x[1] > zb && x[1] < zt) ++inside;
+      if (x[0] > Rc - 2 * h) ztop_far = std::max(ztop_far, x[1]);
+      if (x[0] < R + 2 * h && x[0] > R) ztop_near = std::max(ztop_near, x[1]);
+    }
+    std::printf("rod bottom %.2f top %.2f; fluid inside %d; fluid top far %.2f near %.2f mm\n", 1e3 * zb, 1e3 * zt, inside, 1e3 * ztop_far, 1e3 * ztop_near);
+  }
+  std::printf("[ measured ] floating rod: centre %.4f mm vs Archimedes %.4f mm (draft %.2f mm, h = %.1f mm); "
+              "F/(M g) = %.4f\n", 1e3 * zc, 1e3 * zc_ref, 1e3 * d, 1e3 * h, F / (M * g));
+  EXPECT_NEAR(F, M * g, 0.03 * M * g);
+  EXPECT_NEAR(zc, zc_ref, 0.25 * h);
+}
