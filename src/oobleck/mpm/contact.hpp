@@ -44,6 +44,7 @@
 #include <cmath>
 #include <cstdint>
 #include <vector>
+#include <Eigen/LU>
 
 #include "oobleck/mpm/body.hpp"
 #include "oobleck/mpm/boundary.hpp"
@@ -350,6 +351,107 @@ Vec<G::ncomp> resolve_contact(ContactPair<G>& pair, const RigidMotion<G>& rm, Gr
     if (!rigid) solid.velocity[i] -= (Js + Jf) / mb;
     J_body -= weight[i] * (Js + Jf);
     J_grains += weight[i] * Js;
+  }
+  pair.active_nodes = active;
+  pair.force_N = J_body / dt_s;
+  pair.force_on_grains_N = J_grains / dt_s;
+  pair.impulse_sum_N_s += J_body;
+  return J_body;
+}
+
+/// Contact of a *free rigid* body with the mixture, solved for the body as a whole (model.md §8 in
+/// the rigid limit). Per-node two-body sharing with the body's partial nodal masses lets a rigid
+/// body overtake the mixture it pushes (its fringe nodes share their velocity, the body does
+/// not slow): a rod sank through a fluid that way. Here every approaching phase k at every
+/// contact node i is brought to the body's normal velocity, v_k,i·n_i = V·n_i (the three-body
+/// rule with the whole body as the third body), and V follows from momentum:
+///   (M 1 + Σ w_i m_k,i n_i n_iᵀ) V = M V* + Σ w_i m_k,i (v_k,i·n_i) n_i   (free components),
+/// with the active set (pairs with V·n_i > v_k,i·n_i, i.e. J ≥ 0) found by fixed-point iteration
+/// (≤ 20 passes; it settles in 1–3). Then Coulomb friction on the grains with the body as the
+/// infinite-mass partner, J_t = min(μ J_n, m_s |w_t|), its reaction summed into V. Momentum is
+/// conserved exactly (each phase impulse is matched by the body's). Returns the body impulse.
+template <class G>
+Vec<G::ncomp> resolve_rigid_contact(ContactPair<G>& pair, RigidMotion<G>& rm, const GridField<G>& solid,
+                                    GridField<G>* grains, GridField<G>* fluid, const std::vector<double>& weight,
+                                    const double* mixture_volume, const std::vector<double>& node_volume,
+                                    const Vec<G::dim>* mixture_gradient, double dt_s) {
+  constexpr int NC = G::ncomp, D = G::dim;
+  const int nn = solid.nodes();
+  const double M = rm.mass_kg;
+  const Vec<NC> Vstar = rm.velocity_m_s;  // V* = V + Δt g (set by the caller)
+  auto normal_at = [&](int i, Vec<NC>& n) -> bool {
+    const double mb = solid.mass_kg[i];
+    if (!(mb > 0.0) || weight[i] == 0.0) return false;
+    const double ms = grains ? grains->mass_kg[i] : 0.0, mf = fluid ? fluid->mass_kg[i] : 0.0;
+    if (!(ms > 0.0) && !(mf > 0.0)) return false;
+    if (pair.overlap_threshold > 0.0 &&
+        pair.volume_m3[i] + mixture_volume[i] < pair.overlap_threshold * node_volume[i])
+      return false;
+    Vec<D> g = pair.mass_gradient[i];
+    if (mixture_gradient) g -= mixture_gradient[i];
+    const double gn = g.norm();
+    if (!(gn > 0.0)) return false;
+    n.setZero();
+    n.template head<D>() = g / gn;
+    return true;
+  };
+  // Active-set iteration for V.
+  Vec<NC> V = Vstar;
+  for (int it = 0; it < 20; ++it) {
+    Mat<NC, NC> A = M * Mat<NC, NC>::Identity();
+    Vec<NC> b = M * Vstar;
+    for (int i = 0; i < nn; ++i) {
+      Vec<NC> n;
+      if (!normal_at(i, n)) continue;
+      const double vbn = V.dot(n);
+      for (GridField<G>* ph : {grains, fluid}) {
+        if (!ph || !(ph->mass_kg[i] > 0.0)) continue;
+        const double vkn = ph->velocity[i].dot(n);
+        if (!(vkn < vbn)) continue;
+        const double wm = weight[i] * ph->mass_kg[i];
+        A += wm * (n * n.transpose());
+        b += (wm * vkn) * n;
+      }
+    }
+    for (int c = 0; c < NC; ++c) {  // held components: V_c = V*_c
+      if (rm.free_mask[c] != 0.0) continue;
+      A.row(c).setZero();
+      A(c, c) = 1.0;
+      b[c] = Vstar[c];
+    }
+    const Vec<NC> V_new = A.partialPivLu().solve(b);
+    const bool settled = (V_new - V).norm() <= 1e-14 * (1.0 + V_new.norm());
+    V = V_new;
+    if (settled && it > 0) break;
+  }
+  // Apply the normal impulses with the final V, then friction (grains) against V.
+  const double mu = pair.friction_coefficient;
+  Vec<NC> J_body = Vec<NC>::Zero(), J_grains = Vec<NC>::Zero();
+  int active = 0;
+  for (int i = 0; i < nn; ++i) {
+    Vec<NC> n;
+    if (!normal_at(i, n)) continue;
+    const double vbn = V.dot(n);
+    bool touched = false;
+    for (GridField<G>* ph : {grains, fluid}) {
+      if (!ph || !(ph->mass_kg[i] > 0.0)) continue;
+      const double m = ph->mass_kg[i];
+      Vec<NC>& v = ph->velocity[i];
+      const double vkn = v.dot(n);
+      if (!(vkn < vbn)) continue;
+      touched = true;
+      Vec<NC> J = (m * (vbn - vkn)) * n;
+      if (ph == grains && mu > 0.0) {
+        Vec<NC> w = v + J / m - V;
+        w -= w.dot(n) * n;
+        const double wt = w.norm();
+        if (wt > 0.0) J -= (std::min(mu * (vbn - vkn) * m, m * wt) / wt) * w;
+      }
+      v += J / m;
+      J_body -= weight[i] * J;
+      if (ph == grains) J_grains += weight[i] * J;
+    }
+    active += touched ? 1 : 0;
   }
   pair.active_nodes = active;
   pair.force_N = J_body / dt_s;

@@ -380,11 +380,15 @@ class Solver {
     for (auto& c : contacts_) {
       scatter_mass_gradient_and_volume<G, K>(*bodies_[c.solid], caches_[c.solid], &c.mass_gradient, c.volume_m3);
       RigidMotion<G>& rm = rigid_[c.solid];
-      const Vec<NC> J = resolve_contact(c, rm, fields_[c.solid], grains, fluid, contact_weight_, mixture_volume,
-                                        node_measure_, c.combined_normal ? mixture_gradient_.data() : nullptr,
-                                        opt_.dt_s);
-      if (rm.kind == BodyMotion::FreeRigid && rm.mass_kg > 0.0)
+      const Vec<D>* mix_grad = c.combined_normal ? mixture_gradient_.data() : nullptr;
+      if (rm.kind == BodyMotion::FreeRigid && rm.mass_kg > 0.0) {  // whole-body solve
+        const Vec<NC> J = resolve_rigid_contact(c, rm, fields_[c.solid], grains, fluid, contact_weight_,
+                                                mixture_volume, node_measure_, mix_grad, opt_.dt_s);
         rm.velocity_m_s += J.cwiseProduct(rm.free_mask) / rm.mass_kg;
+      } else {  // deformable or prescribed: node by node
+        resolve_contact(c, rm, fields_[c.solid], grains, fluid, contact_weight_, mixture_volume, node_measure_,
+                        mix_grad, opt_.dt_s);
+      }
     }
   }
 
