@@ -5,7 +5,8 @@
 //   gradient for the contact normal) whose points move rigidly instead of following the grid:
 //     - Prescribed: every point moves at a fixed velocity v_0, every step, exactly (intruder);
 //     - FreeRigid:  translation only, V_{n+1} = V_n + Δt g + (Σ_i J_i)/M with J_i the contact
-//                   impulses the body received at its nodes (launched rod). Components whose
+//                   impulses the body received at its nodes (launched rod), the impulses solved
+//                   for the body as a whole (resolve_rigid_contact). Components whose
 //                   `free_mask` entry is 0 are held (axisymmetric: only v_z is free).
 // * Elastic bodies are Solid bodies with any law (LinearElasticLaw): the contact impulses change
 //   their nodal velocities like any other force; a `Motor` holds their mean angular velocity.
