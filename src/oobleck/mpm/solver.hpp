@@ -8,7 +8,8 @@
 //
 // Each body has its own grid field. The phase coupling (porosity, buoyancy split, semi-implicit
 // drag, model.md §5) runs in `update_grid_and_couple()` between the wall folding and the boundary
-// conditions; contact (§8) will plug in at the same place.
+// conditions; contact with third bodies (§8, contact.hpp) follows it in `resolve_contacts()`.
+// Rigid bodies (prescribed or free translation) and motors: see contact.hpp and docs/contact.md.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -25,6 +26,7 @@
 #include "oobleck/material/drag.hpp"
 #include "oobleck/mpm/body.hpp"
 #include "oobleck/mpm/boundary.hpp"
+#include "oobleck/mpm/contact.hpp"
 #include "oobleck/mpm/grid.hpp"
 #include "oobleck/mpm/shape.hpp"
 #include "oobleck/mpm/transfer.hpp"
@@ -104,11 +106,74 @@ class Solver {
     }
     bodies_.push_back(std::make_unique<Body<G>>());
     bodies_.back()->name = name;
+    rigid_.emplace_back();
+    if constexpr (std::is_same_v<G, Axisymmetric>) rigid_.back().free_mask = Vec<NC>(0.0, 1.0, 0.0);
     caches_.emplace_back();
     fields_.emplace_back();
     fields_.back().resize(grid_.node_count(), threads_);
     return *bodies_.back();
   }
+
+  // ---- Third bodies and contact (model.md §8, contact.hpp) -------------------------------------
+
+  /// Make body b rigid, every point moving at v forever (intruder); the contact force on it is
+  /// the reaction the drive must supply.
+  void set_prescribed_velocity(int b, const Vec<NC>& v) {
+    check_solid(b, "prescribed velocity");
+    rigid_[b].kind = BodyMotion::Prescribed;
+    rigid_[b].velocity_m_s = v;
+    for (auto& vp : bodies_[b]->v_m_s) vp = v;
+  }
+  /// Make body b a free rigid body that only translates (launched rod), starting at velocity v;
+  /// driven by gravity and its contact impulses. Components with free_mask 0 are held at v
+  /// (default: all free; axisymmetric: only v_z).
+  void set_free_rigid(int b, const Vec<NC>& v) {
+    check_solid(b, "free rigid");
+    rigid_[b].kind = BodyMotion::FreeRigid;
+    rigid_[b].velocity_m_s = v;
+    for (auto& vp : bodies_[b]->v_m_s) vp = v;
+  }
+  RigidMotion<G>& rigid_motion(int b) { return rigid_[b]; }
+  /// Contact between solid body b and the mixture (its grains and/or fluid body), Coulomb
+  /// coefficient μ between solid and grains (model.md §8). Returns the pair index.
+  int add_contact(int b, double friction_coefficient) {
+    check_solid(b, "contact");
+    if (!(friction_coefficient >= 0.0))
+      throw InputError(fmt::format("mpm: friction coefficient must be >= 0, got {}", friction_coefficient));
+    contacts_.emplace_back();
+    contacts_.back().solid = b;
+    contacts_.back().friction_coefficient = friction_coefficient;
+    contacts_.back().mass_gradient.assign(static_cast<std::size_t>(grid_.node_count()), Vec<D>::Zero());
+    contacts_.back().volume_m3.assign(static_cast<std::size_t>(grid_.node_count()), 0.0);
+    return static_cast<int>(contacts_.size()) - 1;
+  }
+  const ContactPair<G>& contact(int pair) const { return contacts_[pair]; }
+  int contact_count() const { return static_cast<int>(contacts_.size()); }
+  /// Contact force on body b from the mixture over the last step [N] (sum over its pairs; per
+  /// radian in axisymmetric mode, per unit depth in plane strain).
+  Vec<NC> contact_force(int b) const {
+    Vec<NC> F = Vec<NC>::Zero();
+    for (const auto& c : contacts_)
+      if (c.solid == b) F += c.force_N;
+    return F;
+  }
+  /// Velocity-level motor holding the mean angular velocity ω of body b (plane strain; see
+  /// contact.hpp). Returns the motor index.
+  int add_motor(int b, double omega_rad_s, double gain = 1.0) {
+    if constexpr (!std::is_same_v<G, PlaneStrain>) {
+      throw InputError("mpm: motors are implemented in plane strain only");
+    } else {
+      check_solid(b, "motor");
+      if (rigid_[b].rigid()) throw InputError("mpm: a motor drives a deformable body");
+      if (!(gain > 0.0 && gain <= 1.0)) throw InputError(fmt::format("mpm: motor gain must be in (0, 1], got {}", gain));
+      motors_.push_back({});
+      motors_.back().body = b;
+      motors_.back().omega_rad_s = omega_rad_s;
+      motors_.back().gain = gain;
+      return static_cast<int>(motors_.size()) - 1;
+    }
+  }
+  Motor<G>& motor(int m) { return motors_[m]; }
 
   BoundaryConditions<D>& boundaries() { return bc_; }
   const Grid<D>& grid() const { return grid_; }
@@ -158,6 +223,7 @@ class Solver {
     with_support([&](auto S) {
       constexpr int K = ipow(decltype(S)::value, D);
       StepClock clock(timings_);
+      apply_motors();                      // 3'. wheel motor (velocity level, §8) before P2G
       compute_shape_functions();           // 1. N_ip, ∇N_ip cached per point
       clock.lap(timings_.shape);
       particles_to_grid_all<K>();          // 2. mass, momentum, internal force
@@ -166,7 +232,8 @@ class Solver {
       fold_wall_images_all();              // 4a. walls: ghost contributions onto mirrors
       update_grid_and_couple();            // per node, fused: 3a. porosity n_i, buoyancy split
                                            // E28, ∇p_0; 5. v = (mv + Δt f)/m with all non-drag
-                                           // forces; 3b. semi-implicit E29 drag
+                                           // forces; 3b. semi-implicit E29 drag; rigid bodies
+      resolve_contacts<K>();               // 3c. body contact (§8), rigid-body velocities
       apply_boundary_conditions_all();     // 4b. walls on nodal velocities, ghost images
       compute_mixture_flux();              //     q_i = (1−n_i) v^s_i + n_i v^f_i for E27
       clock.lap(timings_.grid);
@@ -239,8 +306,12 @@ class Solver {
   ///    F_d = C_i/(1 + Δt C_i (1/m_s + 1/m_f)) Δv; grains −F_d, fluid +F_d.
   void update_grid_and_couple() {
     const double dt = opt_.dt_s;
-    for (int b = 0; b < body_count(); ++b)
-      if (b != grains_ && b != fluid_) update_grid_velocity(fields_[b], dt);
+    for (int b = 0; b < body_count(); ++b) {
+      if (rigid_[b].rigid())
+        predict_rigid(rigid_[b], *bodies_[b], fields_[b], opt_.gravity_m_s2, dt);
+      else if (b != grains_ && b != fluid_)
+        update_grid_velocity(fields_[b], dt);
+    }
     if (fluid_ < 0) {
       if (grains_ >= 0) update_grid_velocity(fields_[grains_], dt);
       return;
@@ -274,6 +345,63 @@ class Solver {
       s.force_N[i] -= Fd;  // kept for output/diagnostics
       f.force_N[i] += Fd;
     }
+  }
+
+  /// Contact of every pair (model.md §8, contact.hpp), then the free rigid bodies' new velocity
+  /// V = V + Δt g + (Σ impulses)/M on their free components.
+  template <int K>
+  void resolve_contacts() {
+    if (contacts_.empty()) {
+      for (auto& rm : rigid_) rm.velocity_m_s = rm.predicted_m_s;
+      return;
+    }
+    if (contact_weight_.empty()) {  // once: node weights and measures (boundaries are set by now)
+      contact_weight_ = detail::contact_node_weights<D>(grid_, bc_);
+      node_measure_.resize(contact_weight_.size());
+      for (int i = 0; i < grid_.node_count(); ++i) node_measure_[i] = node_measure<G>(grid_, i);
+    }
+    GridField<G>* grains = grains_ >= 0 ? &fields_[grains_] : nullptr;
+    GridField<G>* fluid = fluid_ >= 0 ? &fields_[fluid_] : nullptr;
+    // Nodal mixture volume Σ N V_p: the fluid's (its points carry the mixture volume), else the
+    // grains' (scattered here; fluid-free beds).
+    const double* mixture_volume = nullptr;
+    bool combined = false;
+    for (const auto& c : contacts_) combined = combined || c.combined_normal;
+    const int mix = grains_ >= 0 ? grains_ : fluid_;
+    if (mix >= 0 && (combined || !fluid)) {  // mixture mass gradient and/or volume
+      mixture_volume_.resize(contact_weight_.size());
+      mixture_gradient_.resize(contact_weight_.size());
+      scatter_mass_gradient_and_volume<G, K>(*bodies_[mix], caches_[mix], combined ? &mixture_gradient_ : nullptr,
+                                             mixture_volume_);
+      mixture_volume = mixture_volume_.data();
+    }
+    if (fluid) mixture_volume = fluid->volume_m3.data();  // folded at walls, the same points' volumes
+    for (auto& rm : rigid_) rm.velocity_m_s = rm.predicted_m_s;
+    for (auto& c : contacts_) {
+      scatter_mass_gradient_and_volume<G, K>(*bodies_[c.solid], caches_[c.solid], &c.mass_gradient, c.volume_m3);
+      RigidMotion<G>& rm = rigid_[c.solid];
+      const Vec<D>* mix_grad = c.combined_normal ? mixture_gradient_.data() : nullptr;
+      if (rm.kind == BodyMotion::FreeRigid && rm.mass_kg > 0.0) {  // whole-body solve
+        const Vec<NC> J = resolve_rigid_contact(c, rm, fields_[c.solid], grains, fluid, contact_weight_,
+                                                mixture_volume, node_measure_, mix_grad, opt_.dt_s);
+        rm.velocity_m_s += J.cwiseProduct(rm.free_mask) / rm.mass_kg;
+      } else {  // deformable or prescribed: node by node
+        resolve_contact(c, rm, fields_[c.solid], grains, fluid, contact_weight_, mixture_volume, node_measure_,
+                        mix_grad, opt_.dt_s);
+      }
+    }
+  }
+
+  void apply_motors() {
+    if constexpr (std::is_same_v<G, PlaneStrain>)
+      for (auto& m : motors_) apply_motor(m, *bodies_[m.body], grid_, opt_.dt_s);
+  }
+
+  void check_solid(int b, const char* what) const {
+    if (b < 0 || b >= body_count())
+      throw InputError(fmt::format("mpm: {}: no body with index {}", what, b));
+    if (b == grains_ || b == fluid_)
+      throw InputError(fmt::format("mpm: {}: body '{}' is a mixture phase, not a solid", what, bodies_[b]->name));
   }
 
   static void predict_node(GridField<G>& field, int i, double dt) {
@@ -316,7 +444,10 @@ class Solver {
   template <int K>
   void grid_to_particles_all() {
     for (std::size_t b = 0; b < bodies_.size(); ++b)
-      grid_to_particles<G, K>(*bodies_[b], caches_[b], fields_[b], grid_, opt_.transfer,
+      if (rigid_[b].rigid())
+        move_rigid_points(*bodies_[b], rigid_[b], grid_, opt_.dt_s);
+      else
+        grid_to_particles<G, K>(*bodies_[b], caches_[b], fields_[b], grid_, opt_.transfer,
                               opt_.flip_fraction, opt_.dt_s,
                               static_cast<int>(b) == fluid_ ? porosity_.data() : nullptr,
                               static_cast<int>(b) == fluid_ ? flux_.data() : nullptr);
@@ -331,6 +462,13 @@ class Solver {
   SolverOptions<G> opt_;
   BoundaryConditions<D> bc_{};
   std::vector<std::unique_ptr<Body<G>>> bodies_;
+  std::vector<RigidMotion<G>> rigid_;      ///< per body: deformable, prescribed or free rigid
+  std::vector<ContactPair<G>> contacts_;   ///< solid–mixture contact pairs (§8)
+  std::vector<Motor<G>> motors_;           ///< angular-velocity motors (§8, wheel)
+  std::vector<double> contact_weight_;     ///< per node: weight in the body impulse sums
+  std::vector<double> node_measure_;       ///< per node: h^D (per radian h² r) for the overlap test
+  std::vector<double> mixture_volume_;     ///< nodal grains volume when there is no fluid body
+  std::vector<Vec<D>> mixture_gradient_;   ///< nodal mixture mass gradient (combined normals)
   std::vector<ShapeCache<D>> caches_;
   std::vector<GridField<G>> fields_;
   int threads_ = 1;

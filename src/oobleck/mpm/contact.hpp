@@ -1,0 +1,481 @@
+#pragma once
+// Third bodies and their contact with the mixture (model.md §8).
+//
+// * Rigid bodies are ordinary material-point bodies (so they scatter a nodal mass field and a mass
+//   gradient for the contact normal) whose points move rigidly instead of following the grid:
+//     - Prescribed: every point moves at a fixed velocity v_0, every step, exactly (intruder);
+//     - FreeRigid:  translation only, V_{n+1} = V_n + Δt g + (Σ_i J_i)/M with J_i the contact
+//                   impulses the body received at its nodes (launched rod), the impulses solved
+//                   for the body as a whole (resolve_rigid_contact). Components whose
+//                   `free_mask` entry is 0 are held (axisymmetric: only v_z is free).
+// * Elastic bodies are Solid bodies with any law (LinearElasticLaw): the contact impulses change
+//   their nodal velocities like any other force; a `Motor` holds their mean angular velocity.
+// * Contact (model.md §8) at every node where the solid and the mixture (grains and/or fluid) both
+//   have mass *and their nodal volumes overlap*: Σ_p N_ip V_p summed over the solid's and the
+//   mixture's points is ≥ θ V_node (θ = `overlap_threshold`, 0.98; V_node = h^D, per radian h² r).
+//   By the partition of unity two bodies that exactly touch fill every node's volume (sum = 1),
+//   a gap leaves it below 1, and at a corner next to empty space it is well below 1. The pure
+//   "both have mass" rule of model.md §8 (θ = 0) acts up to a cell early at every edge (see
+//   docs/contact.md for what it does to a sliding block). The outward normal of the solid is
+//   n = ∇m_b/|∇m_b| with ∇m_b,i = Σ_p m_p ∇N_i(x_p) (at a node outside the body every ∇N_i(x_p)
+//   points from the body's points towards the node: outward). Only phases that approach the
+//   solid, (v_k − v_b)·n < 0, are touched:
+//     both grains and fluid approach: the three share the mass-weighted normal velocity
+//       v_n* = (m_b v_b·n + m_s v_s·n + m_f v_f·n)/(m_b + m_s + m_f)        (three-body)
+//     one phase k approaches:  v_n* = (m_b v_b·n + m_k v_k·n)/(m_b + m_k)   (two-body)
+//   Both approach but one, k, is slower towards the solid than the three-body v_n* (v_k·n > v_n*;
+//   e.g. a fast fluid pushes the solid away from slowly approaching grains): k is not in contact
+//   after all, and the other phase's two-body rule applies (its v_n* is lower still, so k stays
+//   out). A phase that does not approach keeps v_k·n ≥ v_b·n ≥ v_n*: it never approaches after
+//   the step. All normal impulses are ≥ 0 (no phase is pulled). Normal impulse on phase k: J_k = m_k (v_n* − v_k·n) n.
+//   Coulomb friction acts between solid and grains only (the fluid slips): the tangential impulse
+//   on the grains is min(μ |J_s|, m_red |w_t|) against the tangential relative velocity w_t after
+//   the normal step, m_red = m_s m_b/(m_s + m_b) (m_s for a prescribed body: infinite mass).
+//   Everything is an impulse [kg m/s] on the nodal momenta; a force is impulse/Δt. (The authors'
+//   stick branch used the stick momentum as a force, a missing 1/Δt: model.md §8 [pitfall]. Here
+//   stick and slip are both impulses, so they cannot disagree in units.)
+//   The solid receives J_b = −(J_s + J_f) at each node: momentum is conserved exactly node by node.
+// * A prescribed body has infinite mass in the contact: v_n* = v_b·n, and J_b is the reaction.
+// * The contact force on the solid, F = Σ_i J_b,i / Δt [N], is an output of every contact pair
+//   (per radian in axisymmetric mode, like the masses: rod acceleration = F_z / M, both per radian).
+//
+// Free functions over arrays; the Solver (solver.hpp) calls them in its grid pass. No allocation
+// inside a step (the nodal mass-gradient buffer is sized once).
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+#include <Eigen/LU>
+
+#include "oobleck/mpm/body.hpp"
+#include "oobleck/mpm/boundary.hpp"
+#include "oobleck/mpm/grid.hpp"
+#include "oobleck/mpm/shape.hpp"
+#include "oobleck/mpm/transfer.hpp"
+
+namespace oobleck::mpm {
+
+/// How a body's points move (model.md §8).
+enum class BodyMotion {
+  Deformable,  ///< ordinary MPM body (law, G2P)
+  Prescribed,  ///< rigid, every point at `RigidMotion::velocity_m_s`, forever
+  FreeRigid,   ///< rigid, translation only, velocity from gravity and the contact impulses
+};
+
+/// Rigid motion of one body.
+template <class G>
+struct RigidMotion {
+  static constexpr int NC = G::ncomp;
+  BodyMotion kind = BodyMotion::Deformable;
+  Vec<NC> velocity_m_s = Vec<NC>::Zero();  ///< v_0 (Prescribed) or the current V (FreeRigid)
+  Vec<NC> free_mask = Vec<NC>::Ones();     ///< FreeRigid: 1 = component free, 0 = held fixed
+  double mass_kg = 0.0;                    ///< Σ m_p (per radian in axisymmetric mode)
+  Vec<NC> predicted_m_s = Vec<NC>::Zero(); ///< V + Δt g of the current step (internal)
+  bool rigid() const { return kind != BodyMotion::Deformable; }
+};
+
+/// Contact between one solid body and the mixture (grains and/or fluid), model.md §8.
+template <class G>
+struct ContactPair {
+  static constexpr int NC = G::ncomp;
+  int solid = -1;                          ///< body index of the solid
+  double friction_coefficient = 0.0;       ///< Coulomb μ between solid and grains [-]
+  Vec<NC> force_N = Vec<NC>::Zero();       ///< contact force on the solid, last step [N]
+  Vec<NC> force_on_grains_N = Vec<NC>::Zero();  ///< part of −force_N acting on the grains [N]
+  Vec<NC> impulse_sum_N_s = Vec<NC>::Zero();    ///< Σ over all steps of the impulse on the solid
+  /// Contact detection (see header): a node is a contact candidate where both have mass and the
+  /// nodal volumes overlap, (V_b,i + V_mix,i) ≥ overlap_threshold · V_node,i. 0 disables the
+  /// volume test (contact wherever both have mass, model.md §8 literally).
+  double overlap_threshold = 0.98;
+  /// Normal from the solid's mass gradient alone (false), or the combined normal of the pair
+  /// n = (∇m_b − ∇m_mix)/|∇m_b − ∇m_mix| (true, default; the mixture's mass gradient from its
+  /// grains, or its fluid when there are no grains; costs one serial scatter over the mixture's
+  /// points per step). Sliding block (docs/contact.md): horizontal/normal force 0.317 with the
+  /// combined normal vs 0.337 with the solid's alone, for μ = 0.3 at 32 cells/m.
+  bool combined_normal = true;
+  int active_nodes = 0;                    ///< nodes where an impulse acted, last step
+  std::vector<Vec<G::dim>> mass_gradient;  ///< nodal ∇m_b (sized once)
+  std::vector<double> volume_m3;           ///< nodal volume Σ N_ip V_p of the solid (sized once)
+};
+
+/// Velocity-level motor (model.md §8, wheel): before each step, the mean angular velocity of the
+/// body about its centre of mass, ω̄ = Σ m (x − x_c) × (v − V_c) / Σ m |x − x_c|², is moved to the
+/// target by a rigid rotation increment Δω = gain (ω* − ω̄) of every point's velocity,
+/// v_p += Δω ẑ × (x_p − x_c) (and the APIC matrix C_p += Δω [[0, −1], [1, 0]], the gradient of that
+/// increment). Σ m (x − x_c) = 0, so the linear momentum (translation) is untouched: the body is
+/// free to translate, fall, roll. The motor torque is I Δω/Δt (plane strain: per unit depth).
+/// Plane strain only.
+template <class G>
+struct Motor {
+  int body = -1;
+  double omega_rad_s = 0.0;     ///< target mean angular velocity ω* (counter-clockwise positive)
+  double gain = 1.0;            ///< fraction of the error removed per step, (0, 1]
+  double omega_measured_rad_s = 0.0;  ///< ω̄ before the last correction
+  double torque_N_m = 0.0;      ///< motor torque of the last step, I Δω/Δt
+  double inertia_kg_m2 = 0.0;   ///< I = Σ m |x − x_c|² at the last step
+  Vec<G::dim> centre_m = Vec<G::dim>::Zero();  ///< centre of mass at the last step
+};
+
+/// Minimum-image difference x − x_ref on periodic axes (a body straddling a periodic seam).
+template <int D>
+Vec<D> periodic_difference(const Grid<D>& grid, const Vec<D>& x, const Vec<D>& x_ref) {
+  Vec<D> d = x - x_ref;
+  for (int a = 0; a < D; ++a) {
+    if (!grid.periodic[a]) continue;
+    const double L = grid.length(a);
+    d[a] -= L * std::round(d[a] / L);
+  }
+  return d;
+}
+
+/// Mean angular velocity, centre and inertia of a plane body (see Motor), positions unwrapped
+/// about the first point on periodic axes.
+template <class G>
+void angular_state(const Body<G>& body, const Grid<G::dim>& grid, double& omega, double& inertia,
+                   Vec<G::dim>& centre, Vec<G::ncomp>& velocity) {
+  static_assert(G::dim == 2 && G::ncomp == 2, "angular_state: plane strain only");
+  const std::int64_t np = body.size();
+  omega = inertia = 0.0;
+  centre.setZero();
+  velocity.setZero();
+  if (np == 0) return;
+  const Vec<2> x0 = body.x_m[0];
+  double M = 0.0;
+  Vec<2> sx = Vec<2>::Zero();
+  for (std::int64_t p = 0; p < np; ++p) {
+    const double m = body.mass_kg[p];
+    M += m;
+    sx += m * periodic_difference<2>(grid, body.x_m[p], x0);
+    velocity += m * body.v_m_s[p];
+  }
+  const Vec<2> dc = sx / M;
+  velocity /= M;
+  double Lz = 0.0;
+  for (std::int64_t p = 0; p < np; ++p) {
+    const double m = body.mass_kg[p];
+    const Vec<2> r = periodic_difference<2>(grid, body.x_m[p], x0) - dc;
+    const Vec<2> u = body.v_m_s[p] - velocity;
+    Lz += m * (r[0] * u[1] - r[1] * u[0]);
+    inertia += m * r.squaredNorm();
+  }
+  omega = inertia > 0.0 ? Lz / inertia : 0.0;
+  centre = x0 + dc;
+  grid.wrap(centre);
+}
+
+/// Apply one motor correction (see Motor) to its body before the step.
+template <class G>
+void apply_motor(Motor<G>& motor, Body<G>& body, const Grid<G::dim>& grid, double dt_s) {
+  Vec<2> centre, V;
+  double omega = 0.0, inertia = 0.0;
+  angular_state(body, grid, omega, inertia, centre, V);
+  const double dw = motor.gain * (motor.omega_rad_s - omega);
+  const std::int64_t np = body.size();
+  Mat<2, 2> dC;
+  dC << 0.0, -dw, dw, 0.0;
+  for (std::int64_t p = 0; p < np; ++p) {
+    const Vec<2> r = periodic_difference<2>(grid, body.x_m[p], centre);
+    body.v_m_s[p] += dw * Vec<2>(-r[1], r[0]);
+    body.C_1_s[p] += dC;
+  }
+  motor.omega_measured_rad_s = omega;
+  motor.inertia_kg_m2 = inertia;
+  motor.centre_m = centre;
+  motor.torque_N_m = inertia * dw / dt_s;
+}
+
+/// Total mass and predicted velocity of a rigid body; its nodal velocity (and v_old) set to the
+/// rigid velocity on every node with mass (model.md §8).
+template <class G>
+void predict_rigid(RigidMotion<G>& rm, const Body<G>& body, GridField<G>& field,
+                   const Vec<G::ncomp>& gravity, double dt_s) {
+  double M = 0.0;
+  for (double m : body.mass_kg) M += m;
+  rm.mass_kg = M;
+  rm.predicted_m_s = rm.velocity_m_s;
+  if (rm.kind == BodyMotion::FreeRigid) rm.predicted_m_s += dt_s * gravity.cwiseProduct(rm.free_mask);
+  const int nn = field.nodes();
+  for (int i = 0; i < nn; ++i) {
+    if (field.mass_kg[i] > 0.0) {
+      field.velocity_old[i] = rm.velocity_m_s;
+      field.velocity[i] = rm.predicted_m_s;
+    } else {
+      field.velocity_old[i].setZero();
+      field.velocity[i].setZero();
+    }
+  }
+}
+
+/// Nodal mass gradient ∇m_b,i = Σ_p m_p ∇N_ip and nodal volume Σ_p N_ip V_p of a body (its
+/// shape cache of the step); `grad` may be null (volume only).
+template <class G, int K>
+void scatter_mass_gradient_and_volume(const Body<G>& body, const ShapeCache<G::dim>& cache,
+                                      std::vector<Vec<G::dim>>* grad, std::vector<double>& volume) {
+  if (grad)
+    for (auto& g : *grad) g.setZero();
+  std::fill(volume.begin(), volume.end(), 0.0);
+  const std::int64_t np = body.size();
+  for (std::int64_t p = 0; p < np; ++p) {
+    const double m = body.mass_kg[p], V = body.volume_m3[p];
+    const std::int64_t o = p * K;
+    for (int k = 0; k < K; ++k) {
+      const int i = cache.node[o + k];
+      if (grad) (*grad)[i] += m * cache.grad[o + k];
+      volume[i] += cache.w[o + k] * V;
+    }
+  }
+}
+
+/// Contact impulses at one node (model.md §8; the algorithm is in the header comment).
+/// n: unit outward normal of the solid; m_b = +∞ (std::isinf) for a prescribed body; m_s or m_f
+/// = 0 for a phase absent at the node. Returns the impulses on the grains (J_s) and the fluid
+/// (J_f); the solid receives −(J_s + J_f). Velocities are not modified.
+template <int NC>
+inline bool contact_impulses(const Vec<NC>& n, double mb, const Vec<NC>& vb, double ms, const Vec<NC>& vs,
+                             double mf, const Vec<NC>& vf, double mu, Vec<NC>& Js, Vec<NC>& Jf) {
+  Js.setZero();
+  Jf.setZero();
+  const double vbn = vb.dot(n), vsn = vs.dot(n), vfn = vf.dot(n);
+  bool app_s = ms > 0.0 && vsn < vbn, app_f = mf > 0.0 && vfn < vbn;
+  if (!app_s && !app_f) return false;
+  const bool infinite = std::isinf(mb);
+  double vn = vbn;
+  if (!infinite) {
+    // Common normal velocity of the solid and the approaching phases. When both approach, one
+    // may end up slower (towards the solid) than the common velocity of the solid with the other
+    // (a fast fluid pushing the solid away from slow grains): that phase is then not in contact;
+    // dropping it lowers the mean further, so one pass settles the set.
+    auto common = [&](bool s, bool f) {
+      const double ps = s ? ms : 0.0, pf = f ? mf : 0.0;
+      return (mb * vbn + ps * vsn + pf * vfn) / (mb + ps + pf);
+    };
+    vn = common(app_s, app_f);
+    if (app_s && app_f) {
+      if (vsn > vn) {
+        app_s = false;
+        vn = common(false, true);
+      } else if (vfn > vn) {
+        app_f = false;
+        vn = common(true, false);
+      }
+    }
+  }
+  if (app_f) Jf = (mf * (vn - vfn)) * n;
+  if (app_s) {
+    const double Jn = ms * (vn - vsn);  // ≥ 0
+    Js = Jn * n;
+    if (mu > 0.0) {
+      // Relative tangential velocity of the grains after the normal step (the solid's velocity
+      // changed by −(J_s + J_f)/m_b).
+      Vec<NC> w = vs - vb + Js / ms;
+      if (!infinite) w += (Js + Jf) / mb;
+      w -= w.dot(n) * n;
+      const double wt = w.norm();
+      if (wt > 0.0) {
+        const double m_red = infinite ? ms : ms * mb / (ms + mb);
+        const double Jt = std::min(mu * Jn, m_red * wt);  // slip: μ J_n; stick: m_red |w_t|
+        Js -= (Jt / wt) * w;
+      }
+    }
+  }
+  return true;
+}
+
+namespace detail {
+/// Weight of a node's impulse in the body sums: 0 on ghost layers behind walls (their velocities
+/// are images, overwritten by the boundary conditions), ½ per wall the node lies on (the folded
+/// nodal mass there is half image), 1 elsewhere (incl. ghost nodes of Open faces).
+template <int D>
+std::vector<double> contact_node_weights(const Grid<D>& grid, const BoundaryConditions<D>& bc) {
+  std::vector<double> w(static_cast<std::size_t>(grid.node_count()), 1.0);
+  for (int i = 0; i < grid.node_count(); ++i) {
+    const auto s = grid.unflatten(i);
+    for (int a = 0; a < D; ++a) {
+      if (grid.periodic[a]) continue;
+      const int l = grid.logical_index(a, s[a]);
+      for (int side = 0; side < 2; ++side) {
+        if (bc[2 * a + side].type == WallType::Open) continue;
+        const int depth = side == 0 ? -l : l - grid.cells[a];
+        if (depth > 0) w[i] = 0.0;
+        if (depth == 0) w[i] *= 0.5;
+      }
+    }
+  }
+  return w;
+}
+}  // namespace detail
+
+/// Volume of node i's control volume h^D (per radian: h² r_i) for the overlap test.
+template <class G>
+double node_measure(const Grid<G::dim>& grid, int i) {
+  return G::measure(grid.node_position(i), grid.cell_volume());
+}
+
+/// Resolve one contact pair at every node (model.md §8): impulses applied to the nodal velocities
+/// of the grains, the fluid and a deformable solid (a rigid one only accumulates them), summed
+/// with the node weights into pair.force_N. Serial over nodes (deterministic sums; the solid
+/// occupies few nodes). Returns the total impulse on the solid.
+template <class G>
+Vec<G::ncomp> resolve_contact(ContactPair<G>& pair, const RigidMotion<G>& rm, GridField<G>& solid,
+                              GridField<G>* grains, GridField<G>* fluid, const std::vector<double>& weight,
+                              const double* mixture_volume, const std::vector<double>& node_volume,
+                              const Vec<G::dim>* mixture_gradient, double dt_s) {
+  constexpr int NC = G::ncomp, D = G::dim;
+  Vec<NC> J_body = Vec<NC>::Zero(), J_grains = Vec<NC>::Zero();
+  int active = 0;
+  const bool prescribed = rm.kind == BodyMotion::Prescribed, rigid = rm.rigid();
+  const double mu = pair.friction_coefficient;
+  const Vec<NC> zero = Vec<NC>::Zero();
+  const int nn = solid.nodes();
+  for (int i = 0; i < nn; ++i) {
+    const double mb = solid.mass_kg[i];
+    if (!(mb > 0.0) || weight[i] == 0.0) continue;
+    const double ms = grains ? grains->mass_kg[i] : 0.0, mf = fluid ? fluid->mass_kg[i] : 0.0;
+    if (!(ms > 0.0) && !(mf > 0.0)) continue;
+    if (pair.overlap_threshold > 0.0 &&
+        pair.volume_m3[i] + mixture_volume[i] < pair.overlap_threshold * node_volume[i])
+      continue;  // both have mass, but their smoothed volumes leave a gap: not touching
+    Vec<D> g = pair.mass_gradient[i];
+    if (mixture_gradient) g -= mixture_gradient[i];
+    const double gn = g.norm();
+    if (!(gn > 0.0)) continue;
+    Vec<NC> n = Vec<NC>::Zero();
+    n.template head<D>() = g / gn;  // Σ m_p ∇N_i(x_p) points away from the body at its boundary
+    Vec<NC> Js, Jf;
+    if (!contact_impulses<NC>(n, prescribed ? INFINITY : mb, solid.velocity[i], ms,
+                              ms > 0.0 ? grains->velocity[i] : zero, mf,
+                              mf > 0.0 ? fluid->velocity[i] : zero, mu, Js, Jf))
+      continue;
+    ++active;
+    if (ms > 0.0) grains->velocity[i] += Js / ms;
+    if (mf > 0.0) fluid->velocity[i] += Jf / mf;
+    if (!rigid) solid.velocity[i] -= (Js + Jf) / mb;
+    J_body -= weight[i] * (Js + Jf);
+    J_grains += weight[i] * Js;
+  }
+  pair.active_nodes = active;
+  pair.force_N = J_body / dt_s;
+  pair.force_on_grains_N = J_grains / dt_s;
+  pair.impulse_sum_N_s += J_body;
+  return J_body;
+}
+
+/// Contact of a *free rigid* body with the mixture, solved for the body as a whole (model.md §8 in
+/// the rigid limit). Per-node two-body sharing with the body's partial nodal masses lets a rigid
+/// body overtake the mixture it pushes (its fringe nodes share their velocity, the body does
+/// not slow): a rod sank through a fluid that way. Here every approaching phase k at every
+/// contact node i is brought to the body's normal velocity, v_k,i·n_i = V·n_i (the three-body
+/// rule with the whole body as the third body), and V follows from momentum:
+///   (M 1 + Σ w_i m_k,i n_i n_iᵀ) V = M V* + Σ w_i m_k,i (v_k,i·n_i) n_i   (free components),
+/// with the active set (pairs with V·n_i > v_k,i·n_i, i.e. J ≥ 0) found by fixed-point iteration
+/// (≤ 20 passes; it settles in 1–3). Then Coulomb friction on the grains with the body as the
+/// infinite-mass partner, J_t = min(μ J_n, m_s |w_t|), its reaction summed into V. Momentum is
+/// conserved exactly (each phase impulse is matched by the body's). Returns the body impulse.
+template <class G>
+Vec<G::ncomp> resolve_rigid_contact(ContactPair<G>& pair, RigidMotion<G>& rm, const GridField<G>& solid,
+                                    GridField<G>* grains, GridField<G>* fluid, const std::vector<double>& weight,
+                                    const double* mixture_volume, const std::vector<double>& node_volume,
+                                    const Vec<G::dim>* mixture_gradient, double dt_s) {
+  constexpr int NC = G::ncomp, D = G::dim;
+  const int nn = solid.nodes();
+  const double M = rm.mass_kg;
+  const Vec<NC> Vstar = rm.velocity_m_s;  // V* = V + Δt g (set by the caller)
+  auto normal_at = [&](int i, Vec<NC>& n) -> bool {
+    const double mb = solid.mass_kg[i];
+    if (!(mb > 0.0) || weight[i] == 0.0) return false;
+    const double ms = grains ? grains->mass_kg[i] : 0.0, mf = fluid ? fluid->mass_kg[i] : 0.0;
+    if (!(ms > 0.0) && !(mf > 0.0)) return false;
+    if (pair.overlap_threshold > 0.0 &&
+        pair.volume_m3[i] + mixture_volume[i] < pair.overlap_threshold * node_volume[i])
+      return false;
+    Vec<D> g = pair.mass_gradient[i];
+    if (mixture_gradient) g -= mixture_gradient[i];
+    const double gn = g.norm();
+    if (!(gn > 0.0)) return false;
+    n.setZero();
+    n.template head<D>() = g / gn;
+    return true;
+  };
+  // Active-set iteration for V.
+  Vec<NC> V = Vstar;
+  for (int it = 0; it < 20; ++it) {
+    Mat<NC, NC> A = M * Mat<NC, NC>::Identity();
+    Vec<NC> b = M * Vstar;
+    for (int i = 0; i < nn; ++i) {
+      Vec<NC> n;
+      if (!normal_at(i, n)) continue;
+      const double vbn = V.dot(n);
+      for (GridField<G>* ph : {grains, fluid}) {
+        if (!ph || !(ph->mass_kg[i] > 0.0)) continue;
+        const double vkn = ph->velocity[i].dot(n);
+        if (!(vkn < vbn)) continue;
+        const double wm = weight[i] * ph->mass_kg[i];
+        A += wm * (n * n.transpose());
+        b += (wm * vkn) * n;
+      }
+    }
+    for (int c = 0; c < NC; ++c) {  // held components: V_c = V*_c
+      if (rm.free_mask[c] != 0.0) continue;
+      A.row(c).setZero();
+      A(c, c) = 1.0;
+      b[c] = Vstar[c];
+    }
+    const Vec<NC> V_new = A.partialPivLu().solve(b);
+    const bool settled = (V_new - V).norm() <= 1e-14 * (1.0 + V_new.norm());
+    V = V_new;
+    if (settled && it > 0) break;
+  }
+  // Apply the normal impulses with the final V, then friction (grains) against V.
+  const double mu = pair.friction_coefficient;
+  Vec<NC> J_body = Vec<NC>::Zero(), J_grains = Vec<NC>::Zero();
+  int active = 0;
+  for (int i = 0; i < nn; ++i) {
+    Vec<NC> n;
+    if (!normal_at(i, n)) continue;
+    const double vbn = V.dot(n);
+    bool touched = false;
+    for (GridField<G>* ph : {grains, fluid}) {
+      if (!ph || !(ph->mass_kg[i] > 0.0)) continue;
+      const double m = ph->mass_kg[i];
+      Vec<NC>& v = ph->velocity[i];
+      const double vkn = v.dot(n);
+      if (!(vkn < vbn)) continue;
+      touched = true;
+      Vec<NC> J = (m * (vbn - vkn)) * n;
+      if (ph == grains && mu > 0.0) {
+        Vec<NC> w = v + J / m - V;
+        w -= w.dot(n) * n;
+        const double wt = w.norm();
+        if (wt > 0.0) J -= (std::min(mu * (vbn - vkn) * m, m * wt) / wt) * w;
+      }
+      v += J / m;
+      J_body -= weight[i] * J;
+      if (ph == grains) J_grains += weight[i] * J;
+    }
+    active += touched ? 1 : 0;
+  }
+  pair.active_nodes = active;
+  pair.force_N = J_body / dt_s;
+  pair.force_on_grains_N = J_grains / dt_s;
+  pair.impulse_sum_N_s += J_body;
+  return J_body;
+}
+
+/// Move a rigid body's points rigidly over the step (replaces G2P): x ← x + Δt V, v ← V, C = 0,
+/// L = 0 (its volume and zero stress are kept).
+template <class G>
+void move_rigid_points(Body<G>& body, const RigidMotion<G>& rm, const Grid<G::dim>& grid, double dt_s) {
+  constexpr int D = G::dim;
+  const Vec<G::ncomp> V = rm.velocity_m_s;
+  const std::int64_t np = body.size();
+  for (std::int64_t p = 0; p < np; ++p) {
+    Vec<D> x = body.x_m[p] + dt_s * V.template head<D>();
+    grid.wrap(x);
+    body.x_m[p] = x;
+    body.v_m_s[p] = V;
+    body.C_1_s[p].setZero();
+    body.L_1_s[p].setZero();
+  }
+}
+
+}  // namespace oobleck::mpm
