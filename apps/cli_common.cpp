@@ -1,6 +1,7 @@
 #include "cli_common.hpp"
 
 #include <cstdlib>
+#include <filesystem>
 #include <sys/wait.h>
 
 #include <fmt/format.h>
@@ -47,6 +48,19 @@ void run_tool(const std::string& script, const std::vector<std::string>& args) {
   if (rc != 0) {
     throw NumericalError(fmt::format("plotting failed (exit {}): {}", WEXITSTATUS(rc), cmd));
   }
+}
+
+void plot(const std::string& script, std::vector<std::string> args, const std::string& png) {
+  const std::string tmp = png + ".tmp.png";
+  args.push_back(tmp);
+  try {
+    run_tool(script, args);
+  } catch (...) {
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    throw;
+  }
+  std::filesystem::rename(tmp, png);
 }
 
 std::string num(double v) { return fmt::format("{:.17g}", v); }

@@ -27,6 +27,10 @@ std::string tools_dir();
 /// Run tools/<script> with arguments; throws NumericalError if the script fails.
 void run_tool(const std::string& script, const std::vector<std::string>& args);
 
+/// Run tools/<script> with `args` + a temporary PNG path, renamed to `png` only on success
+/// (no partial figure on failure).
+void plot(const std::string& script, std::vector<std::string> args, const std::string& png);
+
 /// Shortest round-trip representation of a double ("17 significant digits").
 std::string num(double v);
 

@@ -18,19 +18,6 @@
 namespace oobleck::cli {
 namespace {
 
-/// Plot through tools/<script>, writing `png` atomically (temporary file renamed on success).
-void plot(const std::string& script, std::vector<std::string> args, const std::string& png) {
-  const std::string tmp = png + ".tmp.png";
-  args.push_back(tmp);
-  try {
-    run_tool(script, args);
-  } catch (...) {
-    std::error_code ec;
-    std::filesystem::remove(tmp, ec);
-    throw;
-  }
-  std::filesystem::rename(tmp, png);
-}
 
 /// Material overrides shared by the point commands; NaN means "keep the parameter set's value".
 struct MaterialOverrides {

@@ -17,20 +17,6 @@
 namespace oobleck::cli {
 namespace {
 
-/// Run a plotting script that writes `png`, atomically: the script writes a temporary file that
-/// is renamed only when it succeeds.
-void plot(const std::string& script, std::vector<std::string> args, const std::string& png) {
-  const std::string tmp = png + ".tmp.png";
-  args.push_back(tmp);
-  try {
-    run_tool(script, args);
-  } catch (...) {
-    std::error_code ec;
-    std::filesystem::remove(tmp, ec);
-    throw;
-  }
-  std::filesystem::rename(tmp, png);
-}
 
 void flow_curve_command(CLI::App& rheology) {
   auto* cmd = rheology.add_subcommand("flow-curve", "steady flow curves tau(gamma_dot) with every branch (E11)");
