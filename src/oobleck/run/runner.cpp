@@ -9,6 +9,9 @@
 #include <fmt/format.h>
 
 #include "oobleck/analysis/annular.hpp"
+#include "oobleck/analysis/fronts.hpp"
+#include "oobleck/analysis/rod.hpp"
+#include "oobleck/analysis/wheel.hpp"
 #include "oobleck/analysis/summary_json.hpp"
 #include "oobleck/core/error.hpp"
 #include "oobleck/io/checkpoint.hpp"
@@ -23,6 +26,7 @@
 #include "oobleck/mpm/initial_state.hpp"
 #include "oobleck/mpm/laws.hpp"
 #include "oobleck/mpm/solver.hpp"
+#include "oobleck/run/third_bodies.hpp"
 
 namespace oobleck::run {
 
@@ -90,6 +94,35 @@ class SceneRun {
   std::vector<analysis::ShearFrame> shear_frames_;
   void sample_shear_frame();
   analysis::AnnularGeometry annular_geometry() const;
+
+  // [[body]] entries (third_bodies.hpp)
+  struct ThirdBody {
+    int body = -1, pair = -1, motor = -1;
+    const scene::BodyConfig* cfg = nullptr;
+  };
+  std::vector<ThirdBody> third_;
+  int analysed_ = -1;  ///< index into third_ of the analysed body (intrusion, rod, wheel)
+  /// Samples of the analysed body: time, centre of mass, mean velocity, mean contact force over
+  /// the interval since the previous sample (impulse / time), extreme coordinate along the last
+  /// axis (bottom for rod and intruder), motor ω and torque.
+  struct TrackSample {
+    double t = 0.0, bottom = 0.0, omega = 0.0, torque = 0.0;
+    Vd centre = Vd::Zero();
+    Vn velocity = Vn::Zero(), force = Vn::Zero();
+  };
+  std::vector<TrackSample> track_;
+  Vn track_impulse_ = Vn::Zero();  ///< impulse sum at the previous sample
+  double track_time_ = 0.0;        ///< time of the previous sample
+  std::vector<analysis::IntrusionFrame> uz_frames_, f_frames_;  ///< intrusion field samples
+  std::vector<Vd> x0_grains_;      ///< initial grain positions (displacement snapshots)
+  std::size_t next_snapshot_ = 0;
+  std::vector<std::string> snapshot_files_;
+  void build_bodies();
+  void sample_track();
+  void sample_intrusion_fields();
+  void write_due_snapshots(bool final_step);
+  nlohmann::json body_analysis() const;
+  double bed_surface() const;
 };
 
 template <class G>
@@ -148,6 +181,7 @@ void SceneRun<G>::build() {
     }
   }
   fill_regions();
+  build_bodies();
 
   if (cfg_.time.dt_s) {
     dt_ = *cfg_.time.dt_s;
@@ -276,6 +310,144 @@ void SceneRun<G>::fill_regions() {
 }
 
 template <class G>
+void SceneRun<G>::build_bodies() {
+  for (const auto& bc : cfg_.bodies) {
+    ThirdBody tb;
+    tb.cfg = &bc;
+    const int motors_before = bc.motor_omega_rad_s ? 1 : 0;
+    std::tie(tb.body, tb.pair) = add_third_body<G>(*solver_, bc, cfg_.grid.cell_size_m, cfg_.file);
+    if (motors_before) {
+      int m = 0;
+      for (const auto& other : third_) m += other.motor >= 0 ? 1 : 0;
+      tb.motor = m;
+    }
+    if (bc.name == cfg_.analysis.body) analysed_ = static_cast<int>(third_.size());
+    third_.push_back(tb);
+  }
+  if (grains_ >= 0) x0_grains_ = solver_->body(grains_).x_m;
+}
+
+template <class G>
+double SceneRun<G>::bed_surface() const {
+  double top = -INFINITY;
+  for (const auto& r : cfg_.regions)
+    if (r.phase != scene::Phase::Elastic) top = std::max(top, r.max_m[D - 1]);
+  return top;
+}
+
+template <class G>
+void SceneRun<G>::sample_track() {
+  if (analysed_ < 0) return;
+  const ThirdBody& tb = third_[static_cast<std::size_t>(analysed_)];
+  const auto& body = solver_->body(tb.body);
+  TrackSample s;
+  s.t = solver_->time_s();
+  s.centre = centre_of_mass(body, solver_->grid());
+  s.velocity = body.total_momentum() / body.total_mass();
+  s.bottom = INFINITY;
+  for (const auto& x : body.x_m) s.bottom = std::min(s.bottom, x[D - 1]);
+  const Vn J = solver_->contact(tb.pair).impulse_sum_N_s;
+  s.force = s.t > track_time_ ? Vn((J - track_impulse_) / (s.t - track_time_)) : Vn(solver_->contact(tb.pair).force_N);
+  track_impulse_ = J;
+  track_time_ = s.t;
+  if constexpr (std::is_same_v<G, mpm::PlaneStrain>) {
+    if (tb.motor >= 0) {
+      s.omega = solver_->motor(tb.motor).omega_measured_rad_s;
+      s.torque = solver_->motor(tb.motor).torque_N_m;
+    }
+  }
+  track_.push_back(s);
+}
+
+template <class G>
+void SceneRun<G>::sample_intrusion_fields() {
+  if constexpr (D == 2) {
+    if (cfg_.analysis.kind != scene::AnalysisKind::Intrusion || analysed_ < 0) return;
+    std::vector<const mpm::Body<G>*> mix;
+    for (int b : {grains_, fluid_})
+      if (b >= 0) mix.push_back(&solver_->body(b));
+    const auto& tb = third_[static_cast<std::size_t>(analysed_)];
+    double tip = INFINITY;
+    for (const auto& x : solver_->body(tb.body).x_m) tip = std::min(tip, x[1]);
+    tip -= 0.5 * cfg_.grid.cell_size_m / tb.cfg->points_per_cell;  // the flat end, not the lowest point
+    analysis::IntrusionFrame uz;
+    uz.time_s = solver_->time_s();
+    uz.tip_z_m = tip;
+    uz.field = nodal_average<G>(solver_->grid(), mix, [&](std::size_t b, std::int64_t p) { return mix[b]->v_m_s[p][1]; });
+    uz_frames_.push_back(std::move(uz));
+    if (grains_ >= 0 && granular_law_) {
+      analysis::IntrusionFrame ff;
+      ff.time_s = solver_->time_s();
+      ff.tip_z_m = tip;
+      ff.field = nodal_average<G>(solver_->grid(), {&solver_->body(grains_)},
+                                  [&](std::size_t, std::int64_t p) { return granular_law_->f[static_cast<std::size_t>(p)]; });
+      f_frames_.push_back(std::move(ff));
+    }
+  }
+}
+
+template <class G>
+void SceneRun<G>::write_due_snapshots(bool final_step) {
+  if constexpr (D == 2) {
+    const auto& times = cfg_.analysis.snapshot_times_s;
+    while (next_snapshot_ < times.size() &&
+           (solver_->time_s() >= times[next_snapshot_] - 0.5 * dt_ || final_step)) {
+      // Nodal fields (bilinear, mass-weighted; docs/output.md "Snapshots"): mixture velocity,
+      // grain displacement since t = 0, structure f, granular pressure p~, volume fraction phi
+      // (1 - nodal porosity of the step).
+      std::vector<const mpm::Body<G>*> mix;
+      for (int b : {grains_, fluid_})
+        if (b >= 0) mix.push_back(&solver_->body(b));
+      const auto& grid = solver_->grid();
+      auto vel = [&](int c) {
+        return nodal_average<G>(grid, mix, [&](std::size_t b, std::int64_t p) { return mix[b]->v_m_s[p][c]; });
+      };
+      const auto ux = vel(0), uy = vel(1);
+      analysis::GridField2D dx = ux, dy = ux, f = ux, pg = ux;
+      if (grains_ >= 0) {
+        const auto& gb = solver_->body(grains_);
+        const std::vector<const mpm::Body<G>*> gs = {&gb};
+        dx = nodal_average<G>(grid, gs, [&](std::size_t, std::int64_t p) {
+          return mpm::periodic_difference<2>(grid, gb.x_m[p], x0_grains_[static_cast<std::size_t>(p)])[0];
+        });
+        dy = nodal_average<G>(grid, gs, [&](std::size_t, std::int64_t p) {
+          return mpm::periodic_difference<2>(grid, gb.x_m[p], x0_grains_[static_cast<std::size_t>(p)])[1];
+        });
+        f = nodal_average<G>(grid, gs, [&](std::size_t, std::int64_t p) { return granular_law_->f[static_cast<std::size_t>(p)]; });
+        pg = nodal_average<G>(grid, gs, [&](std::size_t, std::int64_t p) { return -gb.stress_Pa[p].trace() / 3.0; });
+      } else {
+        std::fill(dx.values.begin(), dx.values.end(), 0.0);
+        dy = f = pg = dx;
+      }
+      const auto& n_nodal = solver_->nodal_porosity();
+      std::string text = "x,y,u_x,u_y,displacement_x,displacement_y,f,p_grains,phi\n";
+      for (std::size_t j = 0; j < ux.ny; ++j) {
+        for (std::size_t i = 0; i < ux.nx; ++i) {
+          const std::size_t k = j * ux.nx + i;
+          double phi = 0.0;
+          if (!n_nodal.empty()) {
+            const int flat = grid.storage_index(0, static_cast<int>(i)) * grid.stride(0) +
+                             grid.storage_index(1, static_cast<int>(j)) * grid.stride(1);
+            phi = 1.0 - n_nodal[static_cast<std::size_t>(flat)];
+          }
+          text += fmt::format("{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", ux.x(i), ux.y(j),
+                              ux.values[k], uy.values[k], dx.values[k], dy.values[k], f.values[k], pg.values[k], phi);
+        }
+      }
+      const std::string name = fmt::format("snapshot_{}.csv", next_snapshot_);
+      io::write_file_atomically(opt_.out_dir + "/" + name,
+                                fmt::format("# t = {:.9g} s (requested {:.9g} s), step {}\n", solver_->time_s(),
+                                            times[next_snapshot_], solver_->steps()) + text,
+                                "snapshot");
+      snapshot_files_.push_back(name);
+      ++next_snapshot_;
+    }
+  } else {
+    (void)final_step;
+  }
+}
+
+template <class G>
 void SceneRun<G>::check_finite() const {
   for (int b = 0; b < solver_->body_count(); ++b) {
     auto& body = solver_->body(b);
@@ -395,6 +567,15 @@ std::vector<std::string> SceneRun<G>::series_columns() const {
     c.push_back("mass_" + n);
     c.push_back("max_speed_" + n);
   }
+  for (const auto& tb : third_) {
+    const std::string& n = tb.cfg->name;
+    for (int k = 0; k < D; ++k) c.push_back(fmt::format("centre_{}_{}", n, k));
+    for (int k = 0; k < NC; ++k) c.push_back(fmt::format("contact_force_{}_{}", n, k));
+    if (tb.motor >= 0) {
+      c.push_back("omega_" + n);
+      c.push_back("motor_torque_" + n);
+    }
+  }
   return c;
 }
 
@@ -410,6 +591,18 @@ std::vector<double> SceneRun<G>::series_row() const {
     double vmax = 0.0;
     for (const auto& v : body.v_m_s) vmax = std::max(vmax, v.norm());
     r.push_back(vmax);
+  }
+  for (const auto& tb : third_) {
+    const Vd c = centre_of_mass(solver_->body(tb.body), solver_->grid());
+    for (int k = 0; k < D; ++k) r.push_back(c[k]);
+    const Vn F = solver_->contact(tb.pair).force_N;
+    for (int k = 0; k < NC; ++k) r.push_back(F[k]);
+    if (tb.motor >= 0) {
+      if constexpr (std::is_same_v<G, mpm::PlaneStrain>) {
+        r.push_back(solver_->motor(tb.motor).omega_measured_rad_s);
+        r.push_back(solver_->motor(tb.motor).torque_N_m);
+      }
+    }
   }
   return r;
 }
@@ -445,6 +638,26 @@ void SceneRun<G>::write_checkpoint() const {
     cp.array("granular/gamma_dot_p", granular_law_->gamma_dot_p);
   }
   if (fluid_law_) cp.array("fluid/J", fluid_law_->J);
+  for (std::size_t k = 0; k < third_.size(); ++k) {
+    const auto& rm = solver_->rigid_motion(third_[k].body);
+    cp.array(fmt::format("third{}/rigid_velocity", k), std::span<const double>(rm.velocity_m_s.data(), NC));
+    const Vn J = solver_->contact(third_[k].pair).impulse_sum_N_s;
+    cp.array(fmt::format("third{}/impulse_sum", k), std::span<const double>(J.data(), NC));
+  }
+  if (!x0_grains_.empty()) cp.array("analysis/x0_grains", as_doubles(x0_grains_));
+  cp.attribute("next_snapshot", static_cast<std::int64_t>(next_snapshot_));
+  if (!track_.empty()) {
+    std::vector<double> flat;
+    for (const auto& t : track_) {
+      flat.insert(flat.end(), {t.t, t.bottom, t.omega, t.torque});
+      flat.insert(flat.end(), t.centre.data(), t.centre.data() + D);
+      flat.insert(flat.end(), t.velocity.data(), t.velocity.data() + NC);
+      flat.insert(flat.end(), t.force.data(), t.force.data() + NC);
+    }
+    cp.array("analysis/track", flat);
+    cp.array("analysis/track_impulse", std::span<const double>(track_impulse_.data(), NC));
+    cp.attribute("track_time", track_time_);
+  }
   cp.commit();
 }
 
@@ -475,6 +688,33 @@ void SceneRun<G>::restore(const io::Checkpoint& cp) {
     cp.read_into("granular/gamma_dot_p", granular_law_->gamma_dot_p);
   }
   if (fluid_law_) cp.read_into("fluid/J", fluid_law_->J);
+  for (std::size_t k = 0; k < third_.size(); ++k) {
+    auto& rm = solver_->rigid_motion(third_[k].body);
+    cp.read_into(fmt::format("third{}/rigid_velocity", k), std::span<double>(rm.velocity_m_s.data(), NC));
+    Vn J;
+    cp.read_into(fmt::format("third{}/impulse_sum", k), std::span<double>(J.data(), NC));
+    solver_->set_contact_impulse_sum(third_[k].pair, J);
+  }
+  if (!x0_grains_.empty()) cp.read_into("analysis/x0_grains", as_doubles(x0_grains_));
+  next_snapshot_ = static_cast<std::size_t>(cp.int_attribute("next_snapshot"));
+  for (std::size_t k = 0; k < next_snapshot_; ++k) snapshot_files_.push_back(fmt::format("snapshot_{}.csv", k));
+  if (cp.has("analysis/track")) {
+    const auto& flat = cp.doubles("analysis/track");
+    const std::size_t w = 4 + D + 2 * NC;
+    for (std::size_t o = 0; o + w <= flat.size(); o += w) {
+      TrackSample t;
+      t.t = flat[o];
+      t.bottom = flat[o + 1];
+      t.omega = flat[o + 2];
+      t.torque = flat[o + 3];
+      for (int k = 0; k < D; ++k) t.centre[k] = flat[o + 4 + k];
+      for (int k = 0; k < NC; ++k) t.velocity[k] = flat[o + 4 + D + k];
+      for (int k = 0; k < NC; ++k) t.force[k] = flat[o + 4 + D + NC + k];
+      track_.push_back(t);
+    }
+    cp.read_into("analysis/track_impulse", std::span<double>(track_impulse_.data(), NC));
+    track_time_ = cp.real_attribute("track_time");
+  }
   settle_sum_ = cp.real_attribute("settle_sum");
   settle_samples_ = static_cast<long>(cp.int_attribute("settle_samples"));
   solver_->set_clock(cp.time(), cp.step());
@@ -697,6 +937,152 @@ nlohmann::json SceneRun<G>::analysis_result() const {
 }
 
 template <class G>
+nlohmann::json SceneRun<G>::body_analysis() const {
+  nlohmann::json out;
+  // Every body: its motion, whole mass (axisymmetric: 2 pi x per radian; plane strain: per metre
+  // of depth), final centre, velocity and contact force.
+  nlohmann::json bodies = nlohmann::json::object();
+  const double whole = std::is_same_v<G, mpm::Axisymmetric> ? 2.0 * M_PI : 1.0;
+  for (const auto& tb : third_) {
+    const auto& body = solver_->body(tb.body);
+    const Vd c = centre_of_mass(body, solver_->grid());
+    const Vn v = body.total_momentum() / body.total_mass();
+    const Vn F = solver_->contact(tb.pair).force_N;
+    bodies[tb.cfg->name] = {{"motion", scene::to_string(tb.cfg->motion)},
+                            {"points", body.size()},
+                            {"mass", whole * body.total_mass()},
+                            {"centre", std::vector<double>(c.data(), c.data() + D)},
+                            {"velocity", std::vector<double>(v.data(), v.data() + NC)},
+                            {"contact_force_last_step", std::vector<double>(F.data(), F.data() + NC)}};
+  }
+  out["bodies"] = bodies;
+  if (analysed_ < 0 || track_.size() < 2) return out;
+  const ThirdBody& tb = third_[static_cast<std::size_t>(analysed_)];
+  const double h = cfg_.grid.cell_size_m;
+  const double sample_dt = track_[1].t - track_[0].t;
+
+  if (cfg_.analysis.kind == scene::AnalysisKind::Intrusion && !uz_frames_.empty()) {
+    // S3 (scenes.md): fronts of u_z = fraction v_0 and of f = f_threshold below (longitudinal)
+    // and beside (transverse) the intruder; speeds from straight-line fits before a front comes
+    // within two cells of a wall; k_l = v_fl/v_0 - 1, k_t = v_ft/v_0.
+    const double v0 = tb.cfg->velocity_m_s[1];
+    analysis::FrontGeometry geo;
+    geo.direction = v0 < 0 ? -1.0 : 1.0;
+    geo.intruder_radius_m = tb.cfg->max_m[0];
+    geo.axis_r_m = cfg_.grid.origin_m[0];
+    std::size_t window = 1;
+    if (cfg_.analysis.filter_window_s > 0) {
+      window = static_cast<std::size_t>(std::llround(cfg_.analysis.filter_window_s / sample_dt));
+      if (window % 2 == 0) ++window;
+    }
+    analysis::FrontFitOptions fo;
+    fo.wall_margin_m = 2.0 * h;
+    // The bed bottom is the longitudinal wall; fronts are fitted only after the tip entered the bed.
+    fo.t_begin_s = 0.0;
+    auto fronts = [&](const std::vector<analysis::IntrusionFrame>& frames, const analysis::FrontCriterion& crit) {
+      nlohmann::json j;
+      const auto series = analysis::measure_front_series(frames, crit, geo, window);
+      j["series"] = analysis::to_json(series);
+      try {
+        const auto sp = analysis::front_speeds(series, std::fabs(v0), fo);
+        j["speeds"] = analysis::to_json(sp);
+      } catch (const InputError& e) {
+        j["speeds"] = nullptr;
+        j["fit_note"] = e.what();
+      }
+      return j;
+    };
+    nlohmann::json vel = fronts(uz_frames_, analysis::velocity_front(v0, cfg_.analysis.front_fraction));
+    out["velocity_front"] = vel;
+    if (!f_frames_.empty()) out["f_front"] = fronts(f_frames_, analysis::scalar_front(cfg_.analysis.f_threshold));
+    const nlohmann::json& sp = vel["speeds"];
+    for (const char* k : {"v_fl", "v_ft", "k_l", "k_t", "k_l_over_k_t"})
+      out[k] = sp.is_null() ? nlohmann::json(nullptr) : sp[k];
+    out["v0"] = std::fabs(v0);
+    out["filter_window_frames"] = window;
+    out["sample_interval"] = sample_dt;
+  }
+
+  if (cfg_.analysis.kind == scene::AnalysisKind::Rod) {
+    // S2 (scenes.md): rod position, velocity, acceleration (from position by finite differences
+    // over the stencil filter_window, and from the contact force), peak deceleration, impact time,
+    // |dz| vs depth below the rod at the snapshot time.
+    const double g = std::fabs(cfg_.gravity_m_s2[D - 1]);
+    const double M = solver_->rigid_motion(tb.body).mass_kg;  // per radian, like the force
+    analysis::TimeSeries zc, zb, Fz, vz;
+    for (const auto& t : track_) {
+      zc.time.push_back(t.t);
+      zc.value.push_back(t.centre[D - 1]);
+      zb.time.push_back(t.t);
+      zb.value.push_back(t.bottom - 0.5 * h / tb.cfg->points_per_cell);
+      vz.time.push_back(t.t);
+      vz.value.push_back(t.velocity[D - 1]);
+    }
+    for (std::size_t k = 1; k < track_.size(); ++k) {  // force k: mean over (t_{k-1}, t_k]
+      Fz.time.push_back(track_[k].t);
+      Fz.value.push_back(track_[k].force[D - 1]);
+    }
+    std::size_t stencil = 1;
+    if (cfg_.analysis.filter_window_s > 0)
+      stencil = std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(cfg_.analysis.filter_window_s / sample_dt)));
+    out["rod_position"] = analysis::to_json(zb);
+    out["rod_centre"] = analysis::to_json(zc);
+    out["rod_velocity"] = analysis::to_json(vz);
+    out["contact_force"] = analysis::to_json(Fz);
+    out["rod_mass"] = (std::is_same_v<G, mpm::Axisymmetric> ? 2.0 * M_PI : 1.0) * M;
+    const auto a_force = analysis::acceleration_from_force(Fz, M, g);
+    out["rod_acceleration_from_force"] = analysis::to_json(a_force);
+    out["peak_deceleration_from_force"] = analysis::to_json(analysis::peak_deceleration(a_force, -1.0));
+    if (zb.size() >= 2 * stencil + 1) {
+      const auto kin = analysis::rod_kinematics(zb, stencil, analysis::DifferenceTime::midpoint);
+      out["rod_velocity_from_position"] = analysis::to_json(kin.velocity);
+      out["rod_acceleration"] = analysis::to_json(kin.acceleration);
+      out["peak_deceleration"] = analysis::to_json(analysis::peak_deceleration(kin.acceleration, -1.0));
+    }
+    out["difference_stencil_samples"] = stencil;
+    const double surface = bed_surface();
+    out["bed_surface"] = surface;
+    if (auto ti = analysis::impact_time_from_position(zb, surface, -1.0)) out["impact_time"] = *ti;
+    else out["impact_time"] = nullptr;
+    out["final_depth"] = surface - zb.value.back();
+    out["final_velocity"] = vz.value.back();
+  }
+
+  if (cfg_.analysis.kind == scene::AnalysisKind::Wheel) {
+    // S4 (scenes.md): hub (centre of mass) height and distance travelled vs time.
+    analysis::HubTrack hub;
+    for (const auto& t : track_) {
+      hub.time_s.push_back(t.t);
+      hub.x_m.push_back(t.centre[0]);
+      hub.y_m.push_back(t.centre[1]);
+    }
+    analysis::WheelCriteria wc;
+    wc.track_length_m = cfg_.grid.size_m[0];
+    wc.wheel_radius_m = tb.cfg->shape == scene::BodyShape::Disc ? tb.cfg->radius_m
+                                                                : tb.cfg->hub_radius_m + tb.cfg->paddle_length_m;
+    wc.bed_surface_m = bed_surface();
+    double omega = tb.cfg->motor_omega_rad_s.value_or(0.0);
+    wc.forward = omega > 0 ? -1.0 : 1.0;  // counter-clockwise rotation rolls towards -x
+    const auto sum = analysis::summarize_wheel(hub, wc);
+    out.update(analysis::to_json(sum, wc));
+    analysis::TimeSeries height, dist, om;
+    for (std::size_t k = 0; k < track_.size(); ++k) {
+      height.time.push_back(track_[k].t);
+      height.value.push_back(track_[k].centre[1]);
+      dist.time.push_back(track_[k].t);
+      dist.value.push_back(wc.forward * (sum.x_unwrapped_m[k] - sum.x_unwrapped_m[0]));
+      om.time.push_back(track_[k].t);
+      om.value.push_back(track_[k].omega);
+    }
+    out["hub_height"] = analysis::to_json(height);
+    out["distance_travelled"] = analysis::to_json(dist);
+    out["omega_measured"] = analysis::to_json(om);
+    out["omega"] = omega;
+  }
+  return out;
+}
+
+template <class G>
 nlohmann::json SceneRun<G>::run() {
   fs::create_directories(opt_.out_dir);
   const long every_frame = steps_between(cfg_.output.frame_interval_s, std::numeric_limits<long>::max());
@@ -721,6 +1107,12 @@ nlohmann::json SceneRun<G>::run() {
     series->row(series_row());
   }
   if (annular) sample_shear_frame();
+  const bool tracked = analysed_ >= 0;
+  if (tracked && !opt_.restart) {
+    sample_track();
+    sample_intrusion_fields();
+  }
+  if (!opt_.restart) write_due_snapshots(false);
 
   std::int64_t points = 0;
   nlohmann::json per_body;
@@ -743,6 +1135,11 @@ nlohmann::json SceneRun<G>::run() {
     check_finite();
     sample_analysis();
     if (annular && (s % every_sample == 0 || s == total_steps_)) sample_shear_frame();
+    if (tracked && (s % every_sample == 0 || s == total_steps_)) {
+      sample_track();
+      sample_intrusion_fields();
+    }
+    write_due_snapshots(s == total_steps_);
     if (s % every_frame == 0 || s == total_steps_) write_frame(*frames);
     if (s % every_series == 0 || s == total_steps_) series->row(series_row());
     if (every_cp > 0 && s % every_cp == 0) write_checkpoint();
@@ -774,6 +1171,8 @@ nlohmann::json SceneRun<G>::run() {
   j["parameters"] = parameters();
   const nlohmann::json analysis = analysis_result();
   j.update(analysis);
+  if (!third_.empty()) j.update(body_analysis());
+  if (!snapshot_files_.empty()) j["snapshots"] = snapshot_files_;
   io::write_summary(opt_.out_dir, j);
   return j;
 }

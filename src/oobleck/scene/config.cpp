@@ -140,6 +140,111 @@ constexpr std::array<std::pair<const char*, BoundaryType>, 7> kBoundaries{{{"no_
 constexpr std::array<std::pair<const char*, Phase>, 4> kPhases{
     {{"mixture", Phase::Mixture}, {"fluid", Phase::Fluid}, {"grains", Phase::Grains}, {"elastic", Phase::Elastic}}};
 
+constexpr std::array<std::pair<const char*, BodyShape>, 3> kBodyShapes{
+    {{"box", BodyShape::Box}, {"disc", BodyShape::Disc}, {"wheel", BodyShape::Wheel}}};
+constexpr std::array<std::pair<const char*, BodyMotionKind>, 3> kMotions{{{"prescribed", BodyMotionKind::Prescribed},
+                                                                         {"free", BodyMotionKind::Free},
+                                                                         {"elastic", BodyMotionKind::Elastic}}};
+constexpr std::array<std::pair<const char*, AnalysisKind>, 7> kAnalyses{{{"none", AnalysisKind::None},
+                                                                        {"settling", AnalysisKind::Settling},
+                                                                        {"couette", AnalysisKind::Couette},
+                                                                        {"annular", AnalysisKind::Annular},
+                                                                        {"intrusion", AnalysisKind::Intrusion},
+                                                                        {"rod", AnalysisKind::Rod},
+                                                                        {"wheel", AnalysisKind::Wheel}}};
+
+/// One [[body]] table (model.md §8 bodies).
+BodyConfig read_body(io::TomlReader& r, std::size_t index, const SceneConfig& c) {
+  const int dim = c.grid.dim;
+  const int ncomp = c.grid.geometry == Geometry::PlaneStrain ? 2 : 3;
+  BodyConfig b;
+  b.name = r.string_or("name", fmt::format("body{}", index));
+  if (b.name == "grains" || b.name == "fluid" || b.name.empty()) {
+    r.fail("name", fmt::format("= \"{}\": body names must be non-empty and differ from the phases \"grains\", \"fluid\"",
+                               b.name));
+  }
+  b.shape = parse_enum(r, "shape", BodyShape::Box, kBodyShapes);
+  b.motion = parse_enum(r, "motion", BodyMotionKind::Prescribed, kMotions);
+  auto inside_grid = [&](std::string_view key, double lo, double hi, int a) {
+    r.require(lo >= c.grid.origin_m[a] - 1e-12 && hi <= c.grid.origin_m[a] + c.grid.size_m[a] + 1e-12, key, hi,
+              fmt::format("the body must lie inside the grid along axis {}", a));
+  };
+  switch (b.shape) {
+    case BodyShape::Box:
+      b.min_m = read_vec(r, "min", dim, {0, 0, 0}, true);
+      b.max_m = read_vec(r, "max", dim, {0, 0, 0}, true);
+      for (int a = 0; a < dim; ++a) {
+        r.require(b.max_m[a] > b.min_m[a], "max", b.max_m[a], fmt::format("entry {} must exceed min[{}]", a, a));
+        if (!(c.boundary[2 * a].type == BoundaryType::Periodic)) inside_grid("max", b.min_m[a], b.max_m[a], a);
+      }
+      break;
+    case BodyShape::Disc:
+    case BodyShape::Wheel: {
+      if (c.grid.geometry != Geometry::PlaneStrain) {
+        r.fail("shape", "discs and wheels are plane-strain bodies (use a box: a cylinder on the axis)");
+      }
+      b.centre_m = read_vec(r, "centre", dim, {0, 0, 0}, true);
+      double R = 0.0;
+      if (b.shape == BodyShape::Disc) {
+        b.radius_m = r.number("radius");
+        r.require(b.radius_m > 0, "radius", b.radius_m, "must be positive [m]");
+        R = b.radius_m;
+      } else {
+        b.hub_radius_m = r.number("hub_radius");
+        b.paddle_length_m = r.number("paddle_length");
+        b.paddle_width_m = r.number("paddle_width");
+        const double np = r.number_or("paddles", 4);
+        b.angle_deg = r.number_or("angle", 0.0);
+        r.require(b.hub_radius_m > 0, "hub_radius", b.hub_radius_m, "must be positive [m]");
+        r.require(b.paddle_length_m >= 0, "paddle_length", b.paddle_length_m, "must be >= 0 [m]");
+        r.require(b.paddle_width_m > 0 && b.paddle_width_m <= 2 * b.hub_radius_m, "paddle_width", b.paddle_width_m,
+                  "must lie in (0, 2 hub_radius] [m]");
+        r.require(np >= 1 && np <= 32 && np == std::floor(np), "paddles", np, "must be a whole number in [1, 32]");
+        b.paddles = static_cast<int>(np);
+        R = b.hub_radius_m + b.paddle_length_m;
+      }
+      for (int a = 0; a < dim; ++a) {
+        if (!(c.boundary[2 * a].type == BoundaryType::Periodic)) inside_grid("centre", b.centre_m[a] - R, b.centre_m[a] + R, a);
+      }
+      break;
+    }
+  }
+  b.velocity_m_s = read_vec(r, "velocity", ncomp, {0, 0, 0}, false, dim);
+  b.points_per_cell = static_cast<int>(r.number_or("points_per_cell", 2));
+  r.require(b.points_per_cell >= 1 && b.points_per_cell <= 8, "points_per_cell", b.points_per_cell,
+            "must be an integer in [1, 8] (per axis)");
+  b.friction = r.number_or("friction", 0.0);
+  r.require(b.friction >= 0, "friction", b.friction, "must be >= 0 (Coulomb coefficient with the grains)");
+  b.mass_kg = r.optional_number("mass");
+  if (b.mass_kg) {
+    r.require(*b.mass_kg > 0, "mass", *b.mass_kg, "must be positive [kg]");
+    if (b.motion != BodyMotionKind::Free) r.fail("mass", "only a free rigid body takes a mass (it sets its density)");
+    if (r.has("density")) r.fail("mass", "give either density or mass, not both");
+    (void)r.optional_number("density");
+  } else {
+    b.density_kg_m3 = r.number("density");
+    r.require(b.density_kg_m3 > 0, "density", b.density_kg_m3, "must be positive [kg/m^3]");
+  }
+  if (b.motion == BodyMotionKind::Elastic) {
+    b.youngs_modulus_Pa = r.number("youngs_modulus");
+    b.poisson_ratio = r.number_or("poisson_ratio", 0.3);
+    r.require(b.youngs_modulus_Pa > 0, "youngs_modulus", b.youngs_modulus_Pa, "must be positive [Pa]");
+    r.require(b.poisson_ratio > -1 && b.poisson_ratio < 0.5, "poisson_ratio", b.poisson_ratio, "must lie in (-1, 0.5)");
+    b.motor_omega_rad_s = r.optional_number("motor_omega");
+    b.motor_gain = r.number_or("motor_gain", 1.0);
+    r.require(b.motor_gain > 0 && b.motor_gain <= 1, "motor_gain", b.motor_gain, "must lie in (0, 1]");
+    if (b.motor_omega_rad_s && c.grid.geometry != Geometry::PlaneStrain) {
+      r.fail("motor_omega", "motors are implemented in plane strain only");
+    }
+  } else {
+    for (const char* k : {"youngs_modulus", "poisson_ratio", "motor_omega", "motor_gain"}) {
+      if (r.has(k)) r.fail(k, fmt::format("only an elastic body (motion = \"elastic\") takes {}", k));
+    }
+  }
+  r.finish();
+  return b;
+}
+
 template <class E, std::size_t N>
 const char* name_of(E e, const std::array<std::pair<const char*, E>, N>& names) {
   for (const auto& [n, v] : names) {
@@ -154,6 +259,8 @@ const char* to_string(Geometry g) { return name_of(g, kGeometries); }
 const char* to_string(ShapeKind s) { return name_of(s, kShapes); }
 const char* to_string(BoundaryType b) { return name_of(b, kBoundaries); }
 const char* to_string(Phase p) { return name_of(p, kPhases); }
+const char* to_string(BodyMotionKind m) { return name_of(m, kMotions); }
+const char* to_string(AnalysisKind k) { return name_of(k, kAnalyses); }
 
 const std::array<const char*, 6>& face_names() {
   static const std::array<const char*, 6> n = {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"};
@@ -355,6 +462,15 @@ SceneConfig load_scene(const std::string& path, const std::vector<std::string>& 
     throw InputError(fmt::format("{}: key 'boundary.x_min': the radial axis cannot be periodic", path));
   }
 
+  // [[body]]: solid third bodies (model.md §8)
+  auto bodies = top.table_array("body");
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    c.bodies.push_back(read_body(bodies[i], i, c));
+    for (std::size_t j = 0; j < i; ++j) {
+      if (c.bodies[j].name == c.bodies[i].name) bodies[i].fail("name", fmt::format("= \"{}\" is used twice", c.bodies[i].name));
+    }
+  }
+
   if (auto ph = top.optional_table("physics")) {
     c.gravity_m_s2 = read_vec(*ph, "gravity", dim, {0, 0, 0}, false);
     ph->finish();
@@ -383,11 +499,7 @@ SceneConfig load_scene(const std::string& path, const std::vector<std::string>& 
     o->finish();
   }
   if (auto an = top.optional_table("analysis")) {
-    constexpr std::array<std::pair<const char*, AnalysisKind>, 4> kKinds{{{"none", AnalysisKind::None},
-                                                                          {"settling", AnalysisKind::Settling},
-                                                                          {"couette", AnalysisKind::Couette},
-                                                                          {"annular", AnalysisKind::Annular}}};
-    c.analysis.kind = parse_enum(*an, "kind", AnalysisKind::None, kKinds);
+    c.analysis.kind = parse_enum(*an, "kind", AnalysisKind::None, kAnalyses);
     c.analysis.average_from_s = an->number_or("average_from", 0.0);
     an->require(c.analysis.average_from_s >= 0 && c.analysis.average_from_s < c.time.duration_s, "average_from",
                 c.analysis.average_from_s, "must lie in [0, time.duration) [s]");
@@ -397,6 +509,50 @@ SceneConfig load_scene(const std::string& path, const std::vector<std::string>& 
     if (c.analysis.kind == AnalysisKind::Annular &&
         (c.grid.geometry != Geometry::Axisymmetric || c.boundary[0].type != BoundaryType::Velocity)) {
       an->fail("kind", "\"annular\" needs an axisymmetric grid whose x_min face is a velocity wall (the bob)");
+    }
+    c.analysis.body = an->string_or("body", "");
+    c.analysis.filter_window_s = an->number_or("filter_window", 0.0);
+    an->require(c.analysis.filter_window_s >= 0, "filter_window", c.analysis.filter_window_s, "must be >= 0 [s]");
+    c.analysis.front_fraction = an->number_or("front_fraction", 0.5);
+    an->require(c.analysis.front_fraction > 0 && c.analysis.front_fraction < 1, "front_fraction",
+                c.analysis.front_fraction, "must lie in (0, 1)");
+    c.analysis.f_threshold = an->number_or("f_threshold", 0.5);
+    an->require(c.analysis.f_threshold > 0 && c.analysis.f_threshold < 1, "f_threshold", c.analysis.f_threshold,
+                "must lie in (0, 1)");
+    if (an->has("snapshot_times")) {
+      const toml::array* arr = an->raw("snapshot_times")->as_array();
+      if (arr == nullptr) an->fail("snapshot_times", "must be an array of times [s]");
+      for (std::size_t i = 0; i < arr->size(); ++i) {
+        const auto v = (*arr)[i].value<double>();
+        if (!v) an->fail("snapshot_times", fmt::format("entry {} is not a number", i));
+        an->require(*v >= 0 && *v <= c.time.duration_s, "snapshot_times", *v, "entries must lie in [0, time.duration] [s]");
+        if (i > 0) an->require(*v > c.analysis.snapshot_times_s.back(), "snapshot_times", *v, "entries must increase");
+        c.analysis.snapshot_times_s.push_back(*v);
+      }
+      if (c.grid.dim != 2) an->fail("snapshot_times", "nodal-field snapshots are written for 2D grids only");
+    }
+    const bool needs_body = c.analysis.kind == AnalysisKind::Intrusion || c.analysis.kind == AnalysisKind::Rod ||
+                            c.analysis.kind == AnalysisKind::Wheel;
+    if (needs_body) {
+      if (c.bodies.empty()) an->fail("kind", fmt::format("\"{}\" needs a [[body]]", to_string(c.analysis.kind)));
+      if (c.analysis.body.empty()) c.analysis.body = c.bodies.front().name;
+      const BodyConfig* target = nullptr;
+      for (const auto& b : c.bodies)
+        if (b.name == c.analysis.body) target = &b;
+      if (target == nullptr) an->fail("body", fmt::format("= \"{}\": no [[body]] has that name", c.analysis.body));
+      const bool axi = c.grid.geometry == Geometry::Axisymmetric;
+      if (c.analysis.kind == AnalysisKind::Intrusion && !(axi && target->motion == BodyMotionKind::Prescribed)) {
+        an->fail("kind", "\"intrusion\" needs an axisymmetric grid and a prescribed-velocity body");
+      }
+      if (c.analysis.kind == AnalysisKind::Rod && target->motion != BodyMotionKind::Free) {
+        an->fail("kind", "\"rod\" needs a free rigid body (motion = \"free\")");
+      }
+      if (c.analysis.kind == AnalysisKind::Wheel &&
+          !(c.grid.geometry == Geometry::PlaneStrain && target->motion == BodyMotionKind::Elastic)) {
+        an->fail("kind", "\"wheel\" needs a plane-strain grid and an elastic body");
+      }
+    } else if (!c.analysis.body.empty()) {
+      an->fail("body", fmt::format("is only used by the intrusion, rod and wheel analyses"));
     }
     an->finish();
   }

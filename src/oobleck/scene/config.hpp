@@ -27,6 +27,7 @@ const char* to_string(ShapeKind s);
 const char* to_string(BoundaryType b);
 const char* to_string(Phase p);
 
+
 struct GridConfig {
   Geometry geometry = Geometry::PlaneStrain;
   int dim = 2;                              ///< 2 (plane strain, axisymmetric) or 3
@@ -71,6 +72,36 @@ struct RegionConfig {
   ElasticConfig elastic;                                  ///< for phase = "elastic"
 };
 
+/// Shape of a third body (model.md §8). Axisymmetric: a box touching r = 0 is a cylinder.
+enum class BodyShape { Box, Disc, Wheel };
+/// How a third body moves: rigid at a fixed velocity (intruder), free rigid translation under
+/// gravity and contact (rod), or elastic (wheel; optionally with a motor on its mean ω).
+enum class BodyMotionKind { Prescribed, Free, Elastic };
+
+/// A solid third body in contact with the mixture ([[body]] in a scene file).
+struct BodyConfig {
+  std::string name;
+  BodyShape shape = BodyShape::Box;
+  std::array<double, 3> min_m{0, 0, 0}, max_m{0, 0, 0};  ///< [m] box corners (shape = "box")
+  std::array<double, 3> centre_m{0, 0, 0};               ///< [m] centre (disc, wheel)
+  double radius_m = 0.0;                                 ///< [m] disc radius
+  double hub_radius_m = 0.0;                             ///< [m] wheel hub radius
+  double paddle_length_m = 0.0;                          ///< [m] paddle length beyond the hub (tip radius = hub + paddle)
+  double paddle_width_m = 0.0;                           ///< [m] paddle width
+  int paddles = 4;                                       ///< number of paddles (spokes)
+  double angle_deg = 0.0;                                ///< [deg] angle of the first paddle from +x
+  BodyMotionKind motion = BodyMotionKind::Prescribed;
+  std::array<double, 3> velocity_m_s{0, 0, 0};           ///< [m/s] prescribed (or initial) velocity
+  double density_kg_m3 = 0.0;                            ///< [kg/m^3]
+  std::optional<double> mass_kg;                         ///< [kg] whole-body mass (rigid free bodies; sets the density)
+  double youngs_modulus_Pa = 0.0;                        ///< [Pa] elastic bodies
+  double poisson_ratio = 0.3;                            ///< [-] elastic bodies
+  int points_per_cell = 2;                               ///< per axis
+  double friction = 0.0;                                 ///< [-] Coulomb coefficient between body and grains
+  std::optional<double> motor_omega_rad_s;               ///< [rad/s] motor target ω (elastic, plane strain)
+  double motor_gain = 1.0;                               ///< [-] fraction of the ω error removed per step
+};
+
 struct BoundaryConfig {
   BoundaryType type = BoundaryType::NoSlip;
   double friction = 0.0;                        ///< Coulomb coefficient (type = friction)
@@ -90,14 +121,24 @@ struct OutputConfig {
 };
 
 /// Built-in measurement written into summary.json (scenes/verification).
-enum class AnalysisKind { None, Settling, Couette, Annular };
+enum class AnalysisKind { None, Settling, Couette, Annular, Intrusion, Rod, Wheel };
 
 struct AnalysisConfig {
   AnalysisKind kind = AnalysisKind::None;
   double average_from_s = 0.0;   ///< [s] start of the time average (settling)
   double sample_interval_s = 0;  ///< [s] nodal-field sampling interval (annular; 0: duration/200)
   double sample_z_m = NAN;       ///< [m] height of the surface profile line (annular; default 2 cells below the bed top)
+  std::string body;              ///< body analysed (intrusion, rod, wheel; default: the first [[body]])
+  double filter_window_s = 0.0;  ///< [s] intrusion: moving time average of the sampled fields; rod: finite-difference stencil (0: one sample)
+  double front_fraction = 0.5;   ///< [-] velocity front at u_z = fraction v_0 (intrusion)
+  double f_threshold = 0.5;      ///< [-] structure front at f = threshold (intrusion)
+  /// [s] times of nodal-field snapshots written as snapshot_<k>.csv (2D grids): intrusion u_z
+  /// (6.2, 13.2, 20 ms), rod displacement (60 ms), wheel pressure (1 s)
+  std::vector<double> snapshot_times_s;
 };
+
+const char* to_string(BodyMotionKind m);
+const char* to_string(AnalysisKind k);
 
 struct SceneConfig {
   std::string file;
@@ -110,6 +151,7 @@ struct SceneConfig {
   CouplingConfig coupling;
   TransferConfig transfer;
   std::vector<RegionConfig> regions;
+  std::vector<BodyConfig> bodies;
   std::array<BoundaryConfig, 6> boundary;  ///< x_min, x_max, y_min, y_max, z_min, z_max
   std::array<double, 3> gravity_m_s2{0, 0, 0};
   TimeConfig time;

@@ -1,0 +1,183 @@
+#pragma once
+// Scene [[body]] entries (scene/config.hpp BodyConfig) turned into solver bodies (model.md §8):
+// point lattices for boxes, discs and spoked wheels, the rigid/elastic motion, the contact pair
+// and the motor; plus the nodal averages of point fields that the scene analyses and snapshots
+// read (runner.cpp).
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "oobleck/analysis/data.hpp"
+#include "oobleck/core/error.hpp"
+#include "oobleck/mpm/laws.hpp"
+#include "oobleck/mpm/solver.hpp"
+#include "oobleck/scene/config.hpp"
+
+namespace oobleck::run {
+
+/// Whether x lies inside the body's shape (box, disc, or hub + paddles of a spoked wheel).
+/// For periodic axes the caller passes x relative to the centre's image (minimum image).
+template <int D>
+bool inside_body(const scene::BodyConfig& b, const mpm::Vec<D>& x) {
+  switch (b.shape) {
+    case scene::BodyShape::Box:
+      for (int a = 0; a < D; ++a)
+        if (x[a] < b.min_m[a] || x[a] > b.max_m[a]) return false;
+      return true;
+    case scene::BodyShape::Disc:
+    case scene::BodyShape::Wheel: {
+      const double dx = x[0] - b.centre_m[0], dy = x[1] - b.centre_m[1];
+      const double r2 = dx * dx + dy * dy;
+      if (b.shape == scene::BodyShape::Disc) return r2 <= b.radius_m * b.radius_m;
+      if (r2 <= b.hub_radius_m * b.hub_radius_m) return true;
+      const double tip = b.hub_radius_m + b.paddle_length_m;
+      for (int k = 0; k < b.paddles; ++k) {
+        const double th = b.angle_deg * M_PI / 180.0 + 2.0 * M_PI * k / b.paddles;
+        const double along = dx * std::cos(th) + dy * std::sin(th);
+        const double across = -dx * std::sin(th) + dy * std::cos(th);
+        if (along >= 0.0 && along <= tip && std::fabs(across) <= 0.5 * b.paddle_width_m) return true;
+      }
+      return false;
+    }
+  }
+  return false;
+}
+
+/// Bounding box of a body's shape.
+template <int D>
+void body_bounds(const scene::BodyConfig& b, mpm::Vec<D>& lo, mpm::Vec<D>& hi) {
+  if (b.shape == scene::BodyShape::Box) {
+    for (int a = 0; a < D; ++a) {
+      lo[a] = b.min_m[a];
+      hi[a] = b.max_m[a];
+    }
+    return;
+  }
+  const double R = b.shape == scene::BodyShape::Disc ? b.radius_m : b.hub_radius_m + b.paddle_length_m;
+  for (int a = 0; a < D; ++a) {
+    lo[a] = b.centre_m[a] - R;
+    hi[a] = b.centre_m[a] + R;
+  }
+}
+
+/// Add body `bc` to the solver: points on a lattice of points_per_cell per axis inside its
+/// shape, its law (elastic) or rigid motion (prescribed, free), its contact pair with the
+/// mixture and its motor. Returns {body index, contact pair index}.
+template <class G>
+std::pair<int, int> add_third_body(mpm::Solver<G>& solver, const scene::BodyConfig& bc, double h_m,
+                                   const std::string& file) {
+  constexpr int D = G::dim, NC = G::ncomp;
+  mpm::Vec<D> lo, hi;
+  body_bounds<D>(bc, lo, hi);
+  const double dx = h_m / bc.points_per_cell;
+  int n[D];
+  std::int64_t total = 1;
+  for (int a = 0; a < D; ++a) {
+    n[a] = std::max(1, static_cast<int>(std::lround((hi[a] - lo[a]) / dx)));
+    total *= n[a];
+  }
+  double cell = 1.0;
+  for (int a = 0; a < D; ++a) cell *= dx;
+  std::vector<mpm::Vec<D>> xs;
+  std::vector<double> vols;
+  double whole_volume = 0.0;
+  for (std::int64_t q = 0; q < total; ++q) {
+    std::int64_t rem = q;
+    mpm::Vec<D> x;
+    for (int a = D - 1; a >= 0; --a) {
+      const auto i = rem % n[a];
+      rem /= n[a];
+      x[a] = lo[a] + (static_cast<double>(i) + 0.5) * dx;
+    }
+    if (!inside_body<D>(bc, x)) continue;
+    const double v = G::measure(x, cell);
+    whole_volume += std::is_same_v<G, mpm::Axisymmetric> ? 2.0 * M_PI * v : v;
+    solver.grid().wrap(x);
+    xs.push_back(x);
+    vols.push_back(v);
+  }
+  if (xs.empty()) {
+    throw InputError(fmt::format("{}: body '{}' got no material points: it must span at least one point spacing "
+                                 "(cell_size/points_per_cell = {} m)", file, bc.name, dx));
+  }
+  const double density = bc.mass_kg ? *bc.mass_kg / whole_volume : bc.density_kg_m3;
+  mpm::Vec<NC> v0;
+  for (int c = 0; c < NC; ++c) v0[c] = bc.velocity_m_s[c];
+  const int index = solver.body_count();
+  auto& body = solver.add_body(bc.name, mpm::Phase::Solid);
+  if (bc.motion == scene::BodyMotionKind::Elastic) {
+    material::LinearElasticParams ep;
+    ep.youngs_modulus_Pa = bc.youngs_modulus_Pa;
+    ep.poisson_ratio = bc.poisson_ratio;
+    body.set_law(std::make_unique<mpm::LinearElasticLaw<G>>(ep));
+  }
+  for (std::size_t p = 0; p < xs.size(); ++p) body.add_point(xs[p], vols[p], density, v0);
+  if (bc.motion == scene::BodyMotionKind::Prescribed) solver.set_prescribed_velocity(index, v0);
+  if (bc.motion == scene::BodyMotionKind::Free) solver.set_free_rigid(index, v0);
+  const int pair = solver.add_contact(index, bc.friction);
+  if (bc.motor_omega_rad_s) solver.add_motor(index, *bc.motor_omega_rad_s, bc.motor_gain);
+  return {index, pair};
+}
+
+/// Centre of mass of a body, periodic axes unwrapped about its first point (then wrapped).
+template <class G>
+mpm::Vec<G::dim> centre_of_mass(const mpm::Body<G>& body, const mpm::Grid<G::dim>& grid) {
+  constexpr int D = G::dim;
+  if (body.size() == 0) return mpm::Vec<D>::Zero();
+  const mpm::Vec<D> x0 = body.x_m[0];
+  mpm::Vec<D> s = mpm::Vec<D>::Zero();
+  double M = 0.0;
+  for (std::int64_t p = 0; p < body.size(); ++p) {
+    s += body.mass_kg[p] * mpm::periodic_difference<D>(grid, body.x_m[p], x0);
+    M += body.mass_kg[p];
+  }
+  mpm::Vec<D> c = x0 + s / M;
+  grid.wrap(c);
+  return c;
+}
+
+/// Mass-weighted nodal average of a point quantity over one or more bodies on the physical
+/// nodes of a 2D grid, with bilinear (tent) weights: value_i = Σ w_ip m_p q_p / Σ w_ip m_p
+/// (0 where no point contributes). Independent of the solver's kernel: a plain post-processing
+/// interpolation. `value(b, p)` gives q of point p of body b.
+template <class G, class F>
+analysis::GridField2D nodal_average(const mpm::Grid<2>& grid, const std::vector<const mpm::Body<G>*>& bodies,
+                                    F&& value) {
+  analysis::GridField2D out;
+  out.origin_x = grid.origin_m[0];
+  out.origin_y = grid.origin_m[1];
+  out.h = grid.h_m;
+  out.nx = static_cast<std::size_t>(grid.periodic[0] ? grid.cells[0] : grid.cells[0] + 1);
+  out.ny = static_cast<std::size_t>(grid.periodic[1] ? grid.cells[1] : grid.cells[1] + 1);
+  out.values.assign(out.nx * out.ny, 0.0);
+  std::vector<double> mass(out.values.size(), 0.0);
+  for (std::size_t b = 0; b < bodies.size(); ++b) {
+    const auto& body = *bodies[b];
+    for (std::int64_t p = 0; p < body.size(); ++p) {
+      const double q = value(b, p), m = body.mass_kg[p];
+      const double fx = (body.x_m[p][0] - out.origin_x) / out.h, fy = (body.x_m[p][1] - out.origin_y) / out.h;
+      const auto i0 = static_cast<long>(std::floor(fx)), j0 = static_cast<long>(std::floor(fy));
+      const double tx = fx - static_cast<double>(i0), ty = fy - static_cast<double>(j0);
+      for (int dj = 0; dj < 2; ++dj) {
+        for (int di = 0; di < 2; ++di) {
+          long i = i0 + di, j = j0 + dj;
+          if (grid.periodic[0]) i = ((i % static_cast<long>(out.nx)) + static_cast<long>(out.nx)) % static_cast<long>(out.nx);
+          if (grid.periodic[1]) j = ((j % static_cast<long>(out.ny)) + static_cast<long>(out.ny)) % static_cast<long>(out.ny);
+          if (i < 0 || j < 0 || i >= static_cast<long>(out.nx) || j >= static_cast<long>(out.ny)) continue;
+          const double w = (di ? tx : 1.0 - tx) * (dj ? ty : 1.0 - ty) * m;
+          const auto k = static_cast<std::size_t>(j) * out.nx + static_cast<std::size_t>(i);
+          out.values[k] += w * q;
+          mass[k] += w;
+        }
+      }
+    }
+  }
+  for (std::size_t k = 0; k < mass.size(); ++k) out.values[k] = mass[k] > 0.0 ? out.values[k] / mass[k] : 0.0;
+  return out;
+}
+
+}  // namespace oobleck::run
