@@ -103,3 +103,56 @@ TEST(SceneConfig, BenchmarkScenesLoadWithTheAuthorsPointCounts) {
   EXPECT_EQ(b.grid.cells[1], 75);
   EXPECT_NEAR(b.grid.cell_size_m, 2.0 / 150.0, 1e-15);
 }
+
+namespace {
+const std::string kIntrusion = std::string(OOBLECK_SOURCE_DIR) + "/scenes/paper/intrusion.toml";
+/// Error message of loading a copy of intrusion.toml with `from` replaced by `to`.
+std::string intrusion_error(const std::string& from, const std::string& to) {
+  std::string s = read_all(kIntrusion);
+  const auto pos = s.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  s.replace(pos, from.size(), to);
+  const auto path = (std::filesystem::temp_directory_path() / "oobleck_body_test.toml").string();
+  std::ofstream(path) << s;
+  std::string msg;
+  try {
+    scene::load_scene(path);
+  } catch (const InputError& e) {
+    msg = e.what();
+  }
+  std::remove(path.c_str());
+  return msg;
+}
+}  // namespace
+
+TEST(SceneConfig, PaperScenesLoadWithTheirBodiesAndAliases) {
+  const auto i = scene::load_scene(kIntrusion, {"v0=0.5", "phi=0.49"});
+  ASSERT_EQ(i.bodies.size(), 1u);
+  EXPECT_EQ(i.bodies[0].motion, scene::BodyMotionKind::Prescribed);
+  EXPECT_DOUBLE_EQ(i.bodies[0].velocity_m_s[1], -0.5);
+  EXPECT_DOUBLE_EQ(i.regions[0].phi, 0.49);
+  EXPECT_EQ(i.analysis.kind, scene::AnalysisKind::Intrusion);
+  EXPECT_EQ(i.analysis.body, "intruder");
+  const auto w = scene::load_scene(std::string(OOBLECK_SOURCE_DIR) + "/scenes/paper/wheel.toml", {"omega=1"});
+  ASSERT_EQ(w.bodies.size(), 1u);
+  EXPECT_EQ(w.bodies[0].shape, scene::BodyShape::Wheel);
+  EXPECT_DOUBLE_EQ(*w.bodies[0].motor_omega_rad_s, 1.0);
+  const auto r = scene::load_scene(std::string(OOBLECK_SOURCE_DIR) + "/scenes/paper/rod_impact.toml", {"eta_0=1e-3"});
+  EXPECT_DOUBLE_EQ(*r.bodies[0].mass_kg, 0.3);
+  EXPECT_DOUBLE_EQ(r.fluid.eta_0_Pa_s, 1e-3);
+}
+
+TEST(SceneConfig, BodyErrorsNameTheKeyAndRule) {
+  EXPECT_NE(intrusion_error("density = 2700.0", "density = -1.0").find("body[0].density"), std::string::npos);
+  EXPECT_NE(intrusion_error("density = 2700.0", "mass = 1.0").find("only a free rigid body takes a mass"),
+            std::string::npos);
+  EXPECT_NE(intrusion_error("max = [0.005, 0.035]", "max = [0.005, 0.045]").find("inside the grid"), std::string::npos);
+  EXPECT_NE(intrusion_error("motion = \"prescribed\"", "motion = \"rigid\"").find("must be one of prescribed, free, elastic"), std::string::npos);
+  EXPECT_NE(intrusion_error("friction = 0.3", "friction = 0.3\nmotor_omega = 3").find("only an elastic body"),
+            std::string::npos);
+  EXPECT_NE(intrusion_error("kind = \"intrusion\"", "kind = \"intrusion\"\nbody = \"rod\"").find("no [[body]] has that name"),
+            std::string::npos);
+  EXPECT_NE(intrusion_error("kind = \"intrusion\"", "kind = \"wheel\"").find("plane-strain grid"), std::string::npos);
+  EXPECT_NE(intrusion_error("name = \"intruder\"", "name = \"grains\"").find("differ from the phases"),
+            std::string::npos);
+}

@@ -117,6 +117,7 @@ class SceneRun {
   std::vector<Vd> x0_grains_;      ///< initial grain positions (displacement snapshots)
   std::size_t next_snapshot_ = 0;
   std::vector<std::string> snapshot_files_;
+  nlohmann::json rod_profile_;  ///< |dz| vs depth below the rod at the first snapshot (not checkpointed)
   void build_bodies();
   void sample_track();
   void sample_intrusion_fields();
@@ -390,8 +391,11 @@ template <class G>
 void SceneRun<G>::write_due_snapshots(bool final_step) {
   if constexpr (D == 2) {
     const auto& times = cfg_.analysis.snapshot_times_s;
+    // Times after the run's end (a shortened run, --set time.duration) are skipped; the last step
+    // takes a time within half a step of the end (duration = round(duration/dt) steps).
     while (next_snapshot_ < times.size() &&
-           (solver_->time_s() >= times[next_snapshot_] - 0.5 * dt_ || final_step)) {
+           (solver_->time_s() >= times[next_snapshot_] - 0.5 * dt_ ||
+            (final_step && times[next_snapshot_] <= cfg_.time.duration_s))) {
       // Nodal fields (bilinear, mass-weighted; docs/output.md "Snapshots"): mixture velocity,
       // grain displacement since t = 0, structure f, granular pressure p~, volume fraction phi
       // (1 - nodal porosity of the step).
@@ -440,6 +444,22 @@ void SceneRun<G>::write_due_snapshots(bool final_step) {
                                             times[next_snapshot_], solver_->steps()) + text,
                                 "snapshot");
       snapshot_files_.push_back(name);
+      if (cfg_.analysis.kind == scene::AnalysisKind::Rod && analysed_ >= 0 && rod_profile_.is_null()) {
+        // Fig. 7c: |dz| vs depth on the axis below the rod's tip at the first snapshot.
+        const auto& tb = third_[static_cast<std::size_t>(analysed_)];
+        double tip = INFINITY;
+        for (const auto& x : solver_->body(tb.body).x_m) tip = std::min(tip, x[1]);
+        tip -= 0.5 * cfg_.grid.cell_size_m / tb.cfg->points_per_cell;
+        try {
+          const auto prof = analysis::displacement_below_rod(dy, tip, bed_surface(), -1.0, grid.origin_m[0],
+                                                             grid.origin_m[1] + cfg_.grid.cell_size_m);
+          rod_profile_ = analysis::to_json(prof);
+          rod_profile_["time"] = solver_->time_s();
+          rod_profile_["rod_tip"] = tip;
+        } catch (const InputError& e) {
+          rod_profile_ = {{"note", e.what()}};
+        }
+      }
       ++next_snapshot_;
     }
   } else {
@@ -1045,6 +1065,7 @@ nlohmann::json SceneRun<G>::body_analysis() const {
     if (auto ti = analysis::impact_time_from_position(zb, surface, -1.0)) out["impact_time"] = *ti;
     else out["impact_time"] = nullptr;
     out["final_depth"] = surface - zb.value.back();
+    if (!rod_profile_.is_null()) out["displacement_below_rod"] = rod_profile_;
     out["final_velocity"] = vz.value.back();
   }
 

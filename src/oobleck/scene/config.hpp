@@ -91,7 +91,7 @@ struct BodyConfig {
   int paddles = 4;                                       ///< number of paddles (spokes)
   double angle_deg = 0.0;                                ///< [deg] angle of the first paddle from +x
   BodyMotionKind motion = BodyMotionKind::Prescribed;
-  std::array<double, 3> velocity_m_s{0, 0, 0};           ///< [m/s] prescribed (or initial) velocity
+  std::array<double, 3> velocity_m_s{0, 0, 0};           ///< [m/s] prescribed (or initial) velocity (scaled to `speed` when given)
   double density_kg_m3 = 0.0;                            ///< [kg/m^3]
   std::optional<double> mass_kg;                         ///< [kg] whole-body mass (rigid free bodies; sets the density)
   double youngs_modulus_Pa = 0.0;                        ///< [Pa] elastic bodies
