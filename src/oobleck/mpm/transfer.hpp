@@ -218,7 +218,7 @@ void particles_to_grid(const Body<G>& body, const ShapeCache<G::dim>& cache, Gri
     }
   }
   if (team > 1) {
-#pragma omp parallel for schedule(static) num_threads(team)
+#pragma omp parallel for schedule(static) num_threads(team) if (nn >= kParallelMinNodes)
     for (int i = 0; i < nn; ++i) {
       for (int t = 1; t < team; ++t) {
         field.mass_kg[i] += field.t_mass[t - 1][i];
@@ -237,7 +237,7 @@ void particles_to_grid(const Body<G>& body, const ShapeCache<G::dim>& cache, Gri
 template <class G>
 void add_gravity(GridField<G>& field, const Vec<G::ncomp>& g_m_s2) {
   const int nn = field.nodes();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nn >= kParallelMinNodes)
   for (int i = 0; i < nn; ++i) field.force_N[i] += field.mass_kg[i] * g_m_s2;
 }
 
@@ -245,7 +245,7 @@ void add_gravity(GridField<G>& field, const Vec<G::ncomp>& g_m_s2) {
 template <class G>
 void update_grid_velocity(GridField<G>& field, double dt_s) {
   const int nn = field.nodes();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nn >= kParallelMinNodes)
   for (int i = 0; i < nn; ++i) {
     const double m = field.mass_kg[i];
     if (m > 0.0) {
