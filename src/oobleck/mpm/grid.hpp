@@ -21,6 +21,12 @@
 
 namespace oobleck::mpm {
 
+/// Node-local grid loops (gravity, velocity update, P2G thread-copy reduction, wall layers, mixture
+/// flux) run in an OpenMP team only above this many nodes: below it the fork/join (a futex wake-up
+/// per region with OMP_WAIT_POLICY=PASSIVE) costs more than the few ns of work per node. Each node
+/// is independent in these loops, so the results do not depend on the choice.
+inline constexpr int kParallelMinNodes = 1 << 15;
+
 template <int D>
 struct Grid {
   static constexpr int kGhost = 2;

@@ -144,8 +144,13 @@ std::int64_t compute_shape_cache(const Grid<D>& grid, const Kernel& kernel, cons
   cache.reserve(np, K);
   cache.apic_by_gradient = Kernel::apic_by_gradient;
   const double h = grid.h_m, inv_h = 1.0 / h;
-  int stride[D];
-  for (int a = 0; a < D; ++a) stride[a] = grid.stride(a);
+  int stride[D], nodes[D];
+  bool periodic[D];
+  for (int a = 0; a < D; ++a) {
+    stride[a] = grid.stride(a);
+    nodes[a] = grid.nodes(a);
+    periodic[a] = grid.periodic[a];
+  }
   std::int64_t bad = 0;
 #pragma omp parallel for schedule(static) reduction(+ : bad)
   for (std::int64_t p = 0; p < np; ++p) {
@@ -161,9 +166,21 @@ std::int64_t compute_shape_cache(const Grid<D>& grid, const Kernel& kernel, cons
         dw1[a][j] *= inv_h;
         off1[a][j] = (base + j - xi) * h;
         m2 += w1[a][j] * off1[a][j] * off1[a][j];
-        const int st = grid.storage_index(a, base + j);
-        if (st < 0) ok = false;
-        idx1[a][j] = st < 0 ? 0 : st * stride[a];
+      }
+      // Storage indices of base … base + S − 1 (= grid.storage_index, one modulo per axis).
+      if (periodic[a]) {
+        int st = grid.storage_index(a, base);
+        for (int j = 0; j < S; ++j, ++st) {
+          if (st >= nodes[a]) st -= nodes[a];
+          idx1[a][j] = st * stride[a];
+        }
+      } else {
+        for (int j = 0; j < S; ++j) {
+          const int st = base + j + Grid<D>::kGhost;
+          const bool in = st >= 0 && st < nodes[a];
+          ok = ok && in;
+          idx1[a][j] = in ? st * stride[a] : 0;
+        }
       }
       cache.inv_D[p][a] = m2 > 0.0 ? 1.0 / m2 : 0.0;
     }

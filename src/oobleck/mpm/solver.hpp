@@ -324,7 +324,7 @@ class Solver {
     const auto& mx = opt_.mixture;
     const int nn = f.nodes();
     porosity_.resize(static_cast<std::size_t>(nn));
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nn >= kParallelMinNodes / 8)  // ~20 ns per node (drag)
     for (int i = 0; i < nn; ++i) {
       const double V = f.volume_m3[i], ms = grains ? s.mass_kg[i] : 0.0, mf = f.mass_kg[i];
       double n = 1.0;
@@ -423,7 +423,7 @@ class Solver {
     const GridField<G>& f = fields_[fluid_];
     const int nn = f.nodes();
     flux_.resize(static_cast<std::size_t>(nn));
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nn >= kParallelMinNodes)
     for (int i = 0; i < nn; ++i) {
       const double n = porosity_[i];
       flux_[i] = (1.0 - n) * s.velocity[i] + n * f.velocity[i];

@@ -64,6 +64,111 @@ struct GridField {
   int max_threads() const { return static_cast<int>(t_mass.size()) + 1; }
 };
 
+namespace detail {
+using V2 = Eigen::Matrix<double, 2, 1>;
+
+/// Scatter of point p (see particles_to_grid), with the APIC and
+/// split-pressure branches resolved at compile time and scalar per-point temporaries (no
+/// stack round trips of Eigen 3-vectors in the node loop). Arithmetic order per component is that
+/// of the Eigen expressions it replaces.
+template <class G, int K, bool Apic, bool Split>
+inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim>& cache, std::int64_t p,
+                                    double* m, double* mv, double* f, double* fp, double* vol) {
+  constexpr int D = G::dim, NC = G::ncomp;
+  const int* const node = cache.node.data();
+  const double* const wt = cache.w.data();
+  const double* const grad = cache.grad.data()->data();
+  const double* const offset = cache.offset.data()->data();
+  {
+    const double mp = body.mass_kg[p], Vp = body.volume_m3[p];
+    const Vec<NC> vp = body.v_m_s[p];
+    Mat3 sig = body.stress_Pa[p];
+    double Vpres = 0.0;
+    if constexpr (Split) {
+      const double pres = -sig.trace() / 3.0;
+      sig.diagonal().array() += pres;  // τ = σ + p 1
+      Vpres = Vp * pres;
+    }
+    double Vsig[D][NC], Cp[D][NC], v[NC], fpt[NC], fppt[NC];
+    for (int a = 0; a < D; ++a)
+      for (int c = 0; c < NC; ++c) {
+        Vsig[a][c] = Vp * sig(c, a);
+        Cp[a][c] = body.C_1_s[p](c, a);
+      }
+    // Axisymmetric: hoop and inertial terms, applied with weight N_ip (zero-cost otherwise).
+    Vec<NC> f_point = body.f_ext_N[p];  // external point load
+    if constexpr (G::has_hoop_terms) {
+      const Vec<D>& xp = body.x_m[p];
+      f_point += G::hoop_force(sig, xp, Vp) + mp * G::inertial_acceleration(xp, vp);
+      if constexpr (Split) {
+        const Vec<NC> h = G::hoop_force(-(Vpres / Vp) * Mat3::Identity(), xp, Vp);
+        for (int c = 0; c < NC; ++c) fppt[c] = h[c];
+      }
+    }
+    for (int c = 0; c < NC; ++c) {
+      v[c] = vp[c];
+      fpt[c] = f_point[c];
+    }
+    // Components 0–1 as one 2-vector (one SIMD register), component 2 (if any) as a scalar.
+    V2 Vsig2[D], Cp2[D];
+    double Vsig3[D], Cp3[D];
+    for (int a = 0; a < D; ++a) {
+      Vsig2[a] = V2(Vsig[a][0], Vsig[a][1]);
+      Cp2[a] = V2(Cp[a][0], Cp[a][1]);
+      Vsig3[a] = NC == 3 ? Vsig[a][NC - 1] : 0.0;
+      Cp3[a] = NC == 3 ? Cp[a][NC - 1] : 0.0;
+    }
+    const V2 v2(v[0], v[1]), fpt2(fpt[0], fpt[1]);
+    const double v3 = v[NC - 1], fpt3 = fpt[NC - 1];
+    const std::int64_t o = p * K;
+    for (int k = 0; k < K; ++k) {
+      const int i = node[o + k];
+      const double w = wt[o + k];
+      const double* g = grad + (o + k) * D;
+      const double wm = w * mp;
+      double* mvi = mv + static_cast<std::int64_t>(i) * NC;
+      double* fi = f + static_cast<std::int64_t>(i) * NC;
+      m[i] += wm;
+      Eigen::Map<V2> mvi2(mvi), fi2(fi);
+      if constexpr (Apic) {
+        const double* off = offset + (o + k) * D;
+        V2 cx = Cp2[0] * off[0];
+        for (int a = 1; a < D; ++a) cx += Cp2[a] * off[a];
+        mvi2 += wm * (v2 + cx);
+        if constexpr (NC == 3) {
+          double cx3 = Cp3[0] * off[0];
+          for (int a = 1; a < D; ++a) cx3 += Cp3[a] * off[a];
+          mvi[2] += wm * (v3 + cx3);
+        }
+      } else {
+        mvi2 += wm * v2;
+        if constexpr (NC == 3) mvi[2] += wm * v3;
+      }
+      {
+        V2 s2 = Vsig2[0] * g[0];
+        for (int a = 1; a < D; ++a) s2 += Vsig2[a] * g[a];
+        fi2 -= s2;
+        fi2 += w * fpt2;
+        if constexpr (NC == 3) {
+          double s3 = Vsig3[0] * g[0];
+          for (int a = 1; a < D; ++a) s3 += Vsig3[a] * g[a];
+          fi[2] -= s3;
+          fi[2] += w * fpt3;
+        }
+      }
+      if constexpr (Split) {
+        double* fpi = fp + static_cast<std::int64_t>(i) * NC;
+        for (int a = 0; a < D; ++a) fpi[a] += Vpres * g[a];
+        if constexpr (G::has_hoop_terms)
+          for (int c = 0; c < NC; ++c) fpi[c] += w * fppt[c];
+        vol[i] += w * Vp;
+      }
+    }
+  }
+}
+
+}  // namespace detail
+
 /// P2G (model.md §6 step 2): nodal mass, momentum (with the APIC affine term when `apic`),
 /// internal force f_i = −∑_p V_p σ_p ∇N_ip, and external point loads ∑_p N_ip f_ext,p. K = local nodes per point (support^dim).
 /// With `split_pressure` (the fluid phase) the stress is split as σ = τ − p 1 (p = −tr σ/3): the
@@ -72,7 +177,7 @@ struct GridField {
 template <class G, int K>
 void particles_to_grid(const Body<G>& body, const ShapeCache<G::dim>& cache, GridField<G>& field, bool apic,
                        bool split_pressure = false) {
-  constexpr int D = G::dim, NC = G::ncomp;
+  constexpr int NC = G::ncomp;
   const std::int64_t np = body.size();
   const int nn = field.nodes();
   int team = 1;
@@ -97,48 +202,23 @@ void particles_to_grid(const Body<G>& body, const ShapeCache<G::dim>& cache, Gri
         vol[i] = 0.0;
       }
     }
+    double* mvd = mv->data();
+    double* fd = f->data();
+    double* fpd = fp->data();
+    auto scatter = [&]<bool A, bool S>() {
 #pragma omp for schedule(static)
-    for (std::int64_t p = 0; p < np; ++p) {
-      const double mp = body.mass_kg[p], Vp = body.volume_m3[p];
-      const Vec<NC> vp = body.v_m_s[p];
-      const Mat<NC, D> Cp = body.C_1_s[p];
-      Mat3 sig = body.stress_Pa[p];
-      double Vpres = 0.0;
-      if (split_pressure) {
-        const double pres = -sig.trace() / 3.0;
-        sig.diagonal().array() += pres;  // τ = σ + p 1
-        Vpres = Vp * pres;
-      }
-      const Mat<NC, D> Vsig = Vp * sig.template topLeftCorner<NC, D>();
-      // Axisymmetric: hoop and inertial terms, applied with weight N_ip (zero-cost otherwise).
-      Vec<NC> f_point = body.f_ext_N[p], fp_point = Vec<NC>::Zero();  // external point load
-      if constexpr (G::has_hoop_terms) {
-        const Vec<D>& xp = body.x_m[p];
-        f_point += G::hoop_force(sig, xp, Vp) + mp * G::inertial_acceleration(xp, vp);
-        if (split_pressure) fp_point = G::hoop_force(-(Vpres / Vp) * Mat3::Identity(), xp, Vp);
-      }
-      const std::int64_t o = p * K;
-      for (int k = 0; k < K; ++k) {
-        const int i = cache.node[o + k];
-        const double w = cache.w[o + k];
-        m[i] += w * mp;
-        if (apic) {
-          mv[i] += (w * mp) * (vp + Cp * cache.offset[o + k]);
-        } else {
-          mv[i] += (w * mp) * vp;
-        }
-        f[i] -= Vsig * cache.grad[o + k];
-        f[i] += w * f_point;
-        if (split_pressure) {
-          fp[i].template head<D>() += Vpres * cache.grad[o + k];
-          if constexpr (G::has_hoop_terms) fp[i] += w * fp_point;
-          vol[i] += w * Vp;
-        }
-      }
+      for (std::int64_t p = 0; p < np; ++p) detail::particles_to_grid_point<G, K, A, S>(body, cache, p, m, mvd, fd, fpd, vol);
+    };
+    if (apic) {
+      if (split_pressure) scatter.template operator()<true, true>();
+      else scatter.template operator()<true, false>();
+    } else {
+      if (split_pressure) scatter.template operator()<false, true>();
+      else scatter.template operator()<false, false>();
     }
   }
   if (team > 1) {
-#pragma omp parallel for schedule(static) num_threads(team)
+#pragma omp parallel for schedule(static) num_threads(team) if (nn >= kParallelMinNodes)
     for (int i = 0; i < nn; ++i) {
       for (int t = 1; t < team; ++t) {
         field.mass_kg[i] += field.t_mass[t - 1][i];
@@ -157,7 +237,7 @@ void particles_to_grid(const Body<G>& body, const ShapeCache<G::dim>& cache, Gri
 template <class G>
 void add_gravity(GridField<G>& field, const Vec<G::ncomp>& g_m_s2) {
   const int nn = field.nodes();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nn >= kParallelMinNodes)
   for (int i = 0; i < nn; ++i) field.force_N[i] += field.mass_kg[i] * g_m_s2;
 }
 
@@ -165,7 +245,7 @@ void add_gravity(GridField<G>& field, const Vec<G::ncomp>& g_m_s2) {
 template <class G>
 void update_grid_velocity(GridField<G>& field, double dt_s) {
   const int nn = field.nodes();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nn >= kParallelMinNodes)
   for (int i = 0; i < nn; ++i) {
     const double m = field.mass_kg[i];
     if (m > 0.0) {
@@ -177,6 +257,141 @@ void update_grid_velocity(GridField<G>& field, double dt_s) {
     }
   }
 }
+
+namespace detail {
+
+/// G2P for one body with the per-point branches resolved at compile time (APIC or FLIP/PIC,
+/// APIC by gradient, mixture fields). Plain scalar accumulators: the Eigen fixed-size 3-vectors of
+/// the axisymmetric mode went through the stack with partial stores and wide reloads (store
+/// forwarding stalls); the arithmetic and its order per component are unchanged.
+template <class G, int K, bool Apic, bool ByGrad, bool Mixture>
+void grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& cache, const GridField<G>& field,
+                              const Grid<G::dim>& grid, double alpha, double dt_s, const double* porosity,
+                              const Vec<G::ncomp>* mixture_flux) {
+  constexpr int D = G::dim, NC = G::ncomp;
+  const std::int64_t np = body.size();
+  const int* const node = cache.node.data();
+  const double* const wt = cache.w.data();
+  const double* const grad = cache.grad.data()->data();
+  const double* const offset = cache.offset.data()->data();
+  const double* const inv_D = cache.inv_D.data()->data();
+  const double* const vel = field.velocity.data()->data();
+  const double* const vel_old = field.velocity_old.data()->data();
+  const double* const flux = Mixture ? mixture_flux->data() : nullptr;
+  Vec<D>* const xs = body.x_m.data();
+  Vec<NC>* const vs = body.v_m_s.data();
+  Mat<NC, D>* const Cs = body.C_1_s.data();
+  Mat3* const Ls = body.L_1_s.data();
+  double* const Vs = body.volume_m3.data();
+#pragma omp parallel for schedule(static)
+  for (std::int64_t p = 0; p < np; ++p) {
+    // Components 0–1 as one 2-vector (one SIMD register), component 2 (if any) as a scalar.
+    V2 vp2 = V2::Zero(), dv2 = V2::Zero(), q2 = V2::Zero(), gv2[D], B2[D];
+    double vp3 = 0.0, dv3 = 0.0, q3 = 0.0, gv3[D], B3[D];
+    for (int a = 0; a < D; ++a) {
+      gv2[a].setZero();
+      B2[a].setZero();
+      gv3[a] = 0.0;
+      B3[a] = 0.0;
+    }
+    double n_p = 0.0, div_q = 0.0;
+    const std::int64_t o = p * K;
+    for (int k = 0; k < K; ++k) {
+      const int i = node[o + k];
+      const double w = wt[o + k];
+      const double* g = grad + (o + k) * D;
+      const double* vi = vel + static_cast<std::int64_t>(i) * NC;
+      const V2 vi2 = Eigen::Map<const V2>(vi);
+      const double vi3 = NC == 3 ? vi[NC - 1] : 0.0;
+      if constexpr (Mixture) {
+        const double* qi = flux + static_cast<std::int64_t>(i) * NC;
+        n_p += w * porosity[i];
+        double d = qi[0] * g[0];
+        for (int a = 1; a < D; ++a) d += qi[a] * g[a];
+        div_q += d;
+        if constexpr (G::has_hoop_terms) {
+          q2 += w * Eigen::Map<const V2>(qi);
+          q3 += w * qi[2];
+        }
+      }
+      vp2 += w * vi2;
+      if constexpr (NC == 3) vp3 += w * vi3;
+      for (int a = 0; a < D; ++a) {
+        gv2[a] += vi2 * g[a];
+        if constexpr (NC == 3) gv3[a] += vi3 * g[a];
+      }
+      if constexpr (Apic) {
+        if constexpr (!ByGrad) {
+          const double* off = offset + (o + k) * D;
+          const V2 wv2 = w * vi2;
+          const double wv3 = w * vi3;
+          for (int a = 0; a < D; ++a) {
+            B2[a] += wv2 * off[a];
+            if constexpr (NC == 3) B3[a] += wv3 * off[a];
+          }
+        }
+      } else {
+        const double* vo = vel_old + static_cast<std::int64_t>(i) * NC;
+        dv2 += w * (vi2 - Eigen::Map<const V2>(vo));
+        if constexpr (NC == 3) dv3 += w * (vi3 - vo[2]);
+      }
+    }
+    double v_pic[NC], dv[NC], q_p[NC], grad_v[D][NC], B[D][NC];  // column-major like Mat<NC, D>
+    for (int c = 0; c < 2; ++c) {
+      v_pic[c] = vp2[c];
+      dv[c] = dv2[c];
+      q_p[c] = q2[c];
+      for (int a = 0; a < D; ++a) {
+        grad_v[a][c] = gv2[a][c];
+        B[a][c] = B2[a][c];
+      }
+    }
+    if constexpr (NC == 3) {
+      v_pic[2] = vp3;
+      dv[2] = dv3;
+      q_p[2] = q3;
+      for (int a = 0; a < D; ++a) {
+        grad_v[a][2] = gv3[a];
+        B[a][2] = B3[a];
+      }
+    }
+    const Vec<D> x_old = xs[p];
+    Vec<D> x;
+    for (int a = 0; a < D; ++a) x[a] = x_old[a] + dt_s * v_pic[a];
+    grid.wrap(x);
+    xs[p] = x;
+    const Eigen::Map<const Vec<NC>> vpic(v_pic);
+    const Eigen::Map<const Mat<NC, D>> gv(&grad_v[0][0]);
+    if constexpr (Apic) {
+      vs[p] = vpic;
+      if constexpr (ByGrad) {
+        Cs[p] = gv;
+      } else {
+        Mat<NC, D> C;
+        for (int a = 0; a < D; ++a) {
+          const double s = inv_D[p * D + a];
+          for (int c = 0; c < NC; ++c) C(c, a) = B[a][c] * s;
+        }
+        Cs[p] = C;
+      }
+    } else {
+      Vec<NC> v;
+      for (int c = 0; c < NC; ++c) v[c] = alpha * (vs[p][c] + dv[c]) + (1.0 - alpha) * v_pic[c];
+      vs[p] = v;
+    }
+    if constexpr (Mixture) {
+      if constexpr (G::has_hoop_terms) div_q += G::div_extra(Eigen::Map<const Vec<NC>>(q_p), x_old);
+      body.phi[p] = 1.0 - n_p;
+      body.div_q_1_s[p] = div_q;
+    }
+    // L at the start-of-step position from the grid velocity field (hoop entries use Σ N v_i).
+    const Mat3 L = G::velocity_gradient(gv, x_old, vpic);
+    Ls[p] = L;
+    Vs[p] *= std::exp(dt_s * L.trace());  // step 7: V ← V exp(Δt tr L)
+  }
+}
+
+}  // namespace detail
 
 /// G2P (model.md §6 step 6): positions x ← x + Δt ∑N v_i (wrapped on periodic axes), velocities by
 /// the FLIP/PIC blend v ← α (v + ∑N (v_i − v_i^old)) + (1 − α) ∑N v_i or by APIC (v ← ∑N v_i,
@@ -190,55 +405,18 @@ template <class G, int K>
 void grid_to_particles(Body<G>& body, const ShapeCache<G::dim>& cache, const GridField<G>& field,
                        const Grid<G::dim>& grid, Transfer transfer, double flip_fraction, double dt_s,
                        const double* porosity = nullptr, const Vec<G::ncomp>* mixture_flux = nullptr) {
-  constexpr int D = G::dim, NC = G::ncomp;
-  const std::int64_t np = body.size();
-  const bool apic = transfer == Transfer::Apic;
-  const bool by_grad = cache.apic_by_gradient;
-  const double alpha = flip_fraction;
-#pragma omp parallel for schedule(static)
-  for (std::int64_t p = 0; p < np; ++p) {
-    Vec<NC> v_pic = Vec<NC>::Zero(), dv = Vec<NC>::Zero();
-    Mat<NC, D> grad_v = Mat<NC, D>::Zero(), B = Mat<NC, D>::Zero();
-    double n_p = 0.0, div_q = 0.0;
-    Vec<NC> q_p = Vec<NC>::Zero();
-    const std::int64_t o = p * K;
-    for (int k = 0; k < K; ++k) {
-      const int i = cache.node[o + k];
-      const double w = cache.w[o + k];
-      const Vec<NC>& vi = field.velocity[i];
-      if (porosity) {
-        n_p += w * porosity[i];
-        div_q += mixture_flux[i].template head<D>().dot(cache.grad[o + k]);
-        if constexpr (G::has_hoop_terms) q_p += w * mixture_flux[i];
-      }
-      v_pic += w * vi;
-      grad_v += vi * cache.grad[o + k].transpose();
-      if (apic) {
-        B += (w * vi) * cache.offset[o + k].transpose();
-      } else {
-        dv += w * (vi - field.velocity_old[i]);
-      }
-    }
-    const Vec<D> x_old = body.x_m[p];
-    Vec<D> x = x_old + dt_s * v_pic.template head<D>();
-    grid.wrap(x);
-    body.x_m[p] = x;
-    if (apic) {
-      body.v_m_s[p] = v_pic;
-      body.C_1_s[p] = by_grad ? grad_v : Mat<NC, D>(B * cache.inv_D[p].asDiagonal());
-    } else {
-      body.v_m_s[p] = alpha * (body.v_m_s[p] + dv) + (1.0 - alpha) * v_pic;
-    }
-    if (porosity) {
-      if constexpr (G::has_hoop_terms) div_q += G::div_extra(q_p, x_old);
-      body.phi[p] = 1.0 - n_p;
-      body.div_q_1_s[p] = div_q;
-    }
-    // L at the start-of-step position from the grid velocity field (hoop entries use Σ N v_i).
-    const Mat3 L = G::velocity_gradient(grad_v, x_old, v_pic);
-    body.L_1_s[p] = L;
-    body.volume_m3[p] *= std::exp(dt_s * L.trace());  // step 7: V ← V exp(Δt tr L)
-  }
+  const bool mix = porosity != nullptr;
+  auto run = [&]<bool A, bool BG>() {
+    if (mix)
+      detail::grid_to_particles_kernel<G, K, A, BG, true>(body, cache, field, grid, flip_fraction, dt_s, porosity,
+                                                          mixture_flux);
+    else
+      detail::grid_to_particles_kernel<G, K, A, BG, false>(body, cache, field, grid, flip_fraction, dt_s, nullptr,
+                                                           nullptr);
+  };
+  if (transfer != Transfer::Apic) run.template operator()<false, false>();
+  else if (cache.apic_by_gradient) run.template operator()<true, true>();
+  else run.template operator()<true, false>();
 }
 
 }  // namespace oobleck::mpm
