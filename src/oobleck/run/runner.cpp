@@ -666,6 +666,23 @@ void SceneRun<G>::write_checkpoint() const {
   }
   if (!x0_grains_.empty()) cp.array("analysis/x0_grains", as_doubles(x0_grains_));
   cp.attribute("next_snapshot", static_cast<std::int64_t>(next_snapshot_));
+  // Sampled nodal fields of the annular and intrusion analyses (all on the grid's nodes).
+  auto save_fields = [&](const std::string& name, const auto& frames, auto field_of) {
+    if (frames.empty()) return;
+    std::vector<double> times, values, tips;
+    for (const auto& fr : frames) {
+      times.push_back(fr.time_s);
+      const auto& f = field_of(fr);
+      values.insert(values.end(), f.values.begin(), f.values.end());
+      if constexpr (requires { fr.tip_z_m; }) tips.push_back(fr.tip_z_m);
+    }
+    cp.array(name + "/time", times);
+    cp.array(name + "/values", values);
+    if (!tips.empty()) cp.array(name + "/tip_z", tips);
+  };
+  save_fields("analysis/shear", shear_frames_, [](const analysis::ShearFrame& f) -> const analysis::GridField2D& { return f.v_theta; });
+  save_fields("analysis/uz", uz_frames_, [](const analysis::IntrusionFrame& f) -> const analysis::GridField2D& { return f.field; });
+  save_fields("analysis/f", f_frames_, [](const analysis::IntrusionFrame& f) -> const analysis::GridField2D& { return f.field; });
   if (!track_.empty()) {
     std::vector<double> flat;
     for (const auto& t : track_) {
@@ -717,6 +734,46 @@ void SceneRun<G>::restore(const io::Checkpoint& cp) {
   }
   if (!x0_grains_.empty()) cp.read_into("analysis/x0_grains", as_doubles(x0_grains_));
   next_snapshot_ = static_cast<std::size_t>(cp.int_attribute("next_snapshot"));
+  // Sampled fields: rebuilt on the grid of this run (same scene, so the same grid).
+  auto load_fields = [&](const std::string& name, auto& frames, const analysis::GridField2D& shape, auto make) {
+    if (!cp.has(name + "/time")) return;
+    const auto& times = cp.doubles(name + "/time");
+    const auto& values = cp.doubles(name + "/values");
+    const std::size_t n = shape.nx * shape.ny;
+    if (values.size() != n * times.size())
+      throw InputError(fmt::format("{}: '{}' does not match this scene's grid", cp.file(), name));
+    for (std::size_t k = 0; k < times.size(); ++k) {
+      analysis::GridField2D f = shape;
+      f.values.assign(values.begin() + static_cast<std::ptrdiff_t>(k * n), values.begin() + static_cast<std::ptrdiff_t>((k + 1) * n));
+      frames.push_back(make(times[k], std::move(f), k));
+    }
+  };
+  if constexpr (D == 2) {
+    const auto& grid = solver_->grid();
+    analysis::GridField2D shape;
+    shape.origin_x = grid.origin_m[0];
+    shape.origin_y = grid.origin_m[1];
+    shape.h = grid.h_m;
+    shape.nx = static_cast<std::size_t>(grid.periodic[0] ? grid.cells[0] : grid.cells[0] + 1);
+    shape.ny = static_cast<std::size_t>(grid.periodic[1] ? grid.cells[1] : grid.cells[1] + 1);
+    load_fields("analysis/shear", shear_frames_, shape, [](double t, analysis::GridField2D f, std::size_t) {
+      analysis::ShearFrame fr;
+      fr.time_s = t;
+      fr.v_theta = std::move(f);
+      return fr;
+    });
+    for (auto [name, frames] : {std::pair{"analysis/uz", &uz_frames_}, std::pair{"analysis/f", &f_frames_}}) {
+      const std::vector<double> tips = cp.has(std::string(name) + "/tip_z") ? cp.doubles(std::string(name) + "/tip_z")
+                                                                             : std::vector<double>{};
+      load_fields(name, *frames, shape, [&](double t, analysis::GridField2D f, std::size_t k) {
+        analysis::IntrusionFrame fr;
+        fr.time_s = t;
+        fr.tip_z_m = k < tips.size() ? tips[k] : 0.0;
+        fr.field = std::move(f);
+        return fr;
+      });
+    }
+  }
   for (std::size_t k = 0; k < next_snapshot_; ++k) snapshot_files_.push_back(fmt::format("snapshot_{}.csv", k));
   if (cp.has("analysis/track")) {
     const auto& flat = cp.doubles("analysis/track");
@@ -1127,7 +1184,7 @@ nlohmann::json SceneRun<G>::run() {
     write_frame(*frames);
     series->row(series_row());
   }
-  if (annular) sample_shear_frame();
+  if (annular && !opt_.restart) sample_shear_frame();  // a restart has its samples from the checkpoint
   const bool tracked = analysed_ >= 0;
   if (tracked && !opt_.restart) {
     sample_track();
