@@ -74,7 +74,40 @@ inline double pow_term(double x, double alpha, double& log_x, bool& have_log) {
   return std::exp(alpha * log_x);
 }
 
-inline bool finite3(const Eigen::Matrix3d& m) { return m.allFinite(); }
+/// m.allFinite() without branches: x * 0 is NaN exactly when x is infinite or NaN.
+inline bool finite3(const Eigen::Matrix3d& m) {
+  const double* x = m.data();
+  double z = 0.0;
+  for (int i = 0; i < 9; ++i) z += x[i] * 0.0;
+  return z == 0.0;
+}
+
+/// E16 trial sig + dt (2 G D + W sig - sig W) + dt (K - 2G/3) tr(D) 1, written out so that it inlines.
+/// Every sum is formed in the order of the Eigen 3.4 expression it replaces (the SSE2 lazy product
+/// sums rows 0-1 as (k0 + k1) + k2 and row 2 as k0 + (k1 + k2); the trace is d00 + (d11 + d22)), so
+/// the result is the same bit for bit. (For W = skew(L), with its zero diagonal, the order is moot.)
+inline Eigen::Matrix3d jaumann_trial(const Eigen::Matrix3d& S, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
+                                     double dt, double G, double K) {
+  const double two_G = 2.0 * G;
+  Eigen::Matrix3d r;
+  for (int j = 0; j < 3; ++j) {
+    for (int i = 0; i < 3; ++i) {
+      double ws, sw;
+      if (i < 2) {
+        ws = (W(i, 0) * S(0, j) + W(i, 1) * S(1, j)) + W(i, 2) * S(2, j);
+        sw = (S(i, 0) * W(0, j) + S(i, 1) * W(1, j)) + S(i, 2) * W(2, j);
+      } else {
+        ws = W(i, 0) * S(0, j) + (W(i, 1) * S(1, j) + W(i, 2) * S(2, j));
+        sw = S(i, 0) * W(0, j) + (S(i, 1) * W(1, j) + S(i, 2) * W(2, j));
+      }
+      r(i, j) = S(i, j) + dt * ((two_G * D(i, j) + ws) - sw);
+    }
+  }
+  const double trD = D(0, 0) + (D(1, 1) + D(2, 2));
+  const double vol = dt * (K - two_G / 3.0) * trD;
+  for (int i = 0; i < 3; ++i) r(i, i) += vol;
+  return r;
+}
 
 }  // namespace
 
@@ -431,6 +464,18 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
 
 GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
                                    double dt, double phi, double eta_0) const {
+  return update_impl<true>(state, D, W, dt, phi, eta_0);
+}
+
+GranularStep GranularLaw::advance(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
+                                  double dt, double phi) const {
+  const GranularUpdate u = update_impl<false>(state, D, W, dt, phi, eta_0_);
+  return GranularStep{u.regime, u.ok(), u.gamma_dot_p};
+}
+
+template <bool kDiagnostics>
+GranularUpdate GranularLaw::update_impl(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
+                                        double dt, double phi, double eta_0) const {
   GranularUpdate out;
   out.f_old = state.f;
   // ---- input checks (never throw in the hot loop; report instead) ----
@@ -445,9 +490,7 @@ GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& 
   out.jammed = phi >= phi_j_;
 
   // ---- E16: elastic trial (D^p = 0), explicit Jaumann rotation with sigma_n ----
-  const double trD = D.trace();
-  Eigen::Matrix3d sig_tr = state.sigma + dt * (2.0 * G_ * D + W * state.sigma - state.sigma * W);
-  sig_tr.diagonal().array() += dt * (K_ - 2.0 * G_ / 3.0) * trD;
+  const Eigen::Matrix3d sig_tr = jaumann_trial(state.sigma, D, W, dt, G_, K_);
   const double p_tr = -sig_tr.trace() / 3.0;
   Eigen::Matrix3d s_tr = sig_tr;
   s_tr.diagonal().array() += p_tr;  // dev sigma_tr
@@ -557,7 +600,9 @@ GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& 
   out.gamma_dot_p = g;
   out.xi_dot_1 = r.xi1;
   out.xi_dot_2 = r.xi2;
-  if (p > 0.0 && g > 0.0) {
+  if constexpr (!kDiagnostics) {
+    (void)a;
+  } else if (p > 0.0 && g > 0.0) {
     out.I_v = eta_0 * g / p;                      // E19
     out.I = g * granular_.d * std::sqrt(granular_.rho_s / p);
     out.I_m = std::sqrt(out.I * out.I + 2.0 * out.I_v);

@@ -46,8 +46,8 @@ class GranularBodyLaw final : public StressLaw<G> {
       const Mat3 D = 0.5 * (L + L.transpose());
       const Mat3 W = 0.5 * (L - L.transpose());
       material::GranularState st{body.stress_Pa[q], f[q]};
-      const material::GranularUpdate u = law_.update(st, D, W, dt_s, phi_of(body, q));
-      if (!u.ok()) {
+      const material::GranularStep u = law_.advance(st, D, W, dt_s, phi_of(body, q));
+      if (!u.ok) {
         first_bad = std::min(first_bad, q);
         continue;
       }
