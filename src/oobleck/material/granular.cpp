@@ -260,37 +260,45 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
       // pressure balance p = p_tr + K dt beta(u) gamma_dot with p = Q(gamma_dot)/u^2 is a quadratic
       // in gamma_dot with one positive root; R(u) = tau_tr - G dt gamma_dot - (mu_p + beta) p is the
       // E21 residual (decreasing in u, see docs/granular.md).
+      // The value (g, p, R) and the derivatives (dg, dp, dR) are separate steps: the f_1 + f_3
+      // branch below needs only the value at u_eq.
       struct Eval {
         double g, dg, p, dp, R, dR;
+        double u, be, mq, disc, gv;  // intermediates of the value reused by the derivatives
       };
-      auto eval = [&](double uu) {
+      auto eval_value = [&](double uu) {
         Eval e{};
-        const double be = beta_of(uu), dbe = dbeta_of(uu);
+        e.u = uu;
+        e.be = beta_of(uu);
         const double A2 = d2_rho_s_;
-        const double B2 = two_eta - Kdt * be * uu * uu;
+        const double B2 = two_eta - Kdt * e.be * uu * uu;
         const double C2 = p_tr * uu * uu;
-        const double disc = std::sqrt(B2 * B2 + 4.0 * A2 * C2);
-        e.g = B2 >= 0.0 ? 2.0 * C2 / (B2 + disc) : (disc - B2) / (2.0 * A2);
-        const double dB2 = -Kdt * (dbe * uu * uu + 2.0 * be * uu);
-        const double dC2 = 2.0 * p_tr * uu;
-        e.dg = disc > 0.0 ? (dC2 - dB2 * e.g) / disc : 0.0;
-        e.p = p_tr + Kdt * be * e.g;
-        e.dp = Kdt * (dbe * e.g + be * e.dg);
-        const double mq = mu_q(uu);
-        const double dmq = b_ == 0.0 ? 0.0 : (mu_2_ - mu_1_) * b_ / ((uu + b_) * (uu + b_));
+        e.disc = std::sqrt(B2 * B2 + 4.0 * A2 * C2);
+        e.g = B2 >= 0.0 ? 2.0 * C2 / (B2 + e.disc) : (e.disc - B2) / (2.0 * A2);
+        e.p = p_tr + Kdt * e.be * e.g;
+        e.mq = mu_q(uu);
         // viscous friction term of E20 times p: (5/2) phi/a * I_v/I_m * p = visc * g/u
-        double gv = 0.0, dgv = 0.0;
-        if (uu > 0.0) {
-          gv = e.g / uu;
-          dgv = e.dg / uu - e.g / (uu * uu);
-        } else {
-          dgv = p_tr / two_eta;  // g ~ p_tr u^2/(2 eta_0) as u -> 0
-        }
-        e.R = tau_tr - Gdt * e.g - (mq + be) * e.p - visc * gv;
-        e.dR = -Gdt * e.dg - (dmq + dbe) * e.p - (mq + be) * e.dp - visc * dgv;
+        e.gv = uu > 0.0 ? e.g / uu : 0.0;
+        e.R = tau_tr - Gdt * e.g - (e.mq + e.be) * e.p - visc * e.gv;
         return e;
       };
-      const Eval e_lo = eval(u_eq);
+      auto eval_derivatives = [&](Eval& e) {
+        const double uu = e.u, be = e.be, dbe = dbeta_of(uu);
+        const double dB2 = -Kdt * (dbe * uu * uu + 2.0 * be * uu);
+        const double dC2 = 2.0 * p_tr * uu;
+        e.dg = e.disc > 0.0 ? (dC2 - dB2 * e.g) / e.disc : 0.0;
+        e.dp = Kdt * (dbe * e.g + be * e.dg);
+        const double dmq = b_ == 0.0 ? 0.0 : (mu_2_ - mu_1_) * b_ / ((uu + b_) * (uu + b_));
+        const double dgv = uu > 0.0 ? e.dg / uu - e.g / (uu * uu)
+                                    : p_tr / two_eta;  // g ~ p_tr u^2/(2 eta_0) as u -> 0
+        e.dR = -Gdt * e.dg - (dmq + dbe) * e.p - (e.mq + be) * e.dp - visc * dgv;
+      };
+      auto eval = [&](double uu) {
+        Eval e = eval_value(uu);
+        eval_derivatives(e);
+        return e;
+      };
+      Eval e_lo = eval_value(u_eq);
       if (e_lo.R <= 0.0 && u_eq > 0.0) {
         // -------- f_1 + f_3 (E21, E23 with K_4 = 0): beta = 0, I_m = u_eq; closed form ----------
         // tau_tr - G dt g = mu_q p + visc g/u_eq with p = Q(g)/u_eq^2: quadratic A g^2 + B g - C = 0.
@@ -308,6 +316,7 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
         regime = g > 0.0 ? GranularRegime::kShearCompaction : GranularRegime::kCompaction;
       } else {
         // -------- f_1 only: root of R(u) on [u_lo, u_hi] --------
+        eval_derivatives(e_lo);
         double lo = u_eq, hi;
         // Upper bracket: with beta >= 0, gamma_dot(u) >= the beta = 0 root, so gamma_dot(u_hi) >= gamma_max
         // when Q(gamma_max)/u_hi^2 <= p_tr; there R <= -(mu_p + beta) p < 0.
