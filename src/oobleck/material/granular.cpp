@@ -49,6 +49,11 @@ GranularLaw::GranularLaw(const rheology::Preset& preset, GranularOptions options
   phi_j_ = steady_.phi_j;
   a_0_ = steady_.a_0;
   a_inf_ = steady_.a_inf;
+  for (const rheology::EtaBTerm& t : steady_.eta_B_terms) {
+    const double r = std::nearbyint(t.alpha);
+    // (a whole alpha < 0, which validation rejects, gives 1 as before: no multiplication)
+    eta_B_int_alpha_.push_back(r == t.alpha && r <= 8.0 ? static_cast<int>(std::max(r, 0.0)) : kNonInteger);
+  }
 }
 
 double GranularLaw::mu_q(double I_m) const {
@@ -59,12 +64,12 @@ double GranularLaw::mu_q(double I_m) const {
 
 namespace {
 
-/// x^alpha for alpha >= 0, with small integer exponents by multiplication (E8 is evaluated per call).
-inline double pow_term(double x, double alpha, double& log_x, bool& have_log) {
-  const double r = std::nearbyint(alpha);
-  if (r == alpha && r <= 8.0) {
+/// x^alpha for alpha >= 0, with small integer exponents by multiplication (E8 is evaluated per call);
+/// int_alpha: alpha as an int when it is a whole number <= 8, else INT_MIN (GranularLaw::kNonInteger).
+inline double pow_term(double x, double alpha, int int_alpha, double& log_x, bool& have_log) {
+  if (int_alpha != std::numeric_limits<int>::min()) {
     double y = 1.0;
-    for (int k = 0; k < static_cast<int>(r); ++k) y *= x;
+    for (int k = 0; k < int_alpha; ++k) y *= x;
     return y;
   }
   if (!have_log) {
@@ -86,10 +91,12 @@ inline bool finite3(const Eigen::Matrix3d& m) {
 /// Every sum is formed in the order of the Eigen 3.4 expression it replaces (the SSE2 lazy product
 /// sums rows 0-1 as (k0 + k1) + k2 and row 2 as k0 + (k1 + k2); the trace is d00 + (d11 + d22)), so
 /// the result is the same bit for bit. (For W = skew(L), with its zero diagonal, the order is moot.)
-inline Eigen::Matrix3d jaumann_trial(const Eigen::Matrix3d& S, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
-                                     double dt, double G, double K) {
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void jaumann_trial(const Eigen::Matrix3d& S, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W, double dt,
+                          double G, double K, Eigen::Matrix3d& r) {
   const double two_G = 2.0 * G;
-  Eigen::Matrix3d r;
   for (int j = 0; j < 3; ++j) {
     for (int i = 0; i < 3; ++i) {
       double ws, sw;
@@ -106,7 +113,6 @@ inline Eigen::Matrix3d jaumann_trial(const Eigen::Matrix3d& S, const Eigen::Matr
   const double trD = D(0, 0) + (D(1, 1) + D(2, 2));
   const double vol = dt * (K - two_G / 3.0) * trD;
   for (int i = 0; i < 3; ++i) r(i, i) += vol;
-  return r;
 }
 
 }  // namespace
@@ -482,8 +488,12 @@ GranularStep GranularLaw::advance(GranularState& state, const Eigen::Matrix3d& D
   return GranularStep{u.regime, u.ok(), u.gamma_dot_p};
 }
 
+// Inlined into update() and advance(), so that advance() drops the stores of what it does not return.
 template <bool kDiagnostics>
-GranularUpdate GranularLaw::update_impl(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline GranularUpdate GranularLaw::update_impl(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
                                         double dt, double phi, double eta_0) const {
   GranularUpdate out;
   out.f_old = state.f;
@@ -499,9 +509,9 @@ GranularUpdate GranularLaw::update_impl(GranularState& state, const Eigen::Matri
   out.jammed = phi >= phi_j_;
 
   // ---- E16: elastic trial (D^p = 0), explicit Jaumann rotation with sigma_n ----
-  const Eigen::Matrix3d sig_tr = jaumann_trial(state.sigma, D, W, dt, G_, K_);
-  const double p_tr = -sig_tr.trace() / 3.0;
-  Eigen::Matrix3d s_tr = sig_tr;
+  Eigen::Matrix3d s_tr;  // the trial stress, then its deviator
+  jaumann_trial(state.sigma, D, W, dt, G_, K_, s_tr);
+  const double p_tr = -s_tr.trace() / 3.0;
   s_tr.diagonal().array() += p_tr;  // dev sigma_tr
   const double tau_tr = std::sqrt(0.5 * s_tr.squaredNorm());
   out.tau_trial = tau_tr;
@@ -513,7 +523,10 @@ GranularUpdate GranularLaw::update_impl(GranularState& state, const Eigen::Matri
   if (const double gap = phi_j_ - phi; gap > 0.0) {
     double lg = 0.0;
     bool have = false;
-    for (const rheology::EtaBTerm& t : steady_.eta_B_terms) inv_eta_B += t.phi_i * pow_term(gap, t.alpha, lg, have);
+    for (std::size_t i = 0; i < steady_.eta_B_terms.size(); ++i) {
+      const rheology::EtaBTerm& t = steady_.eta_B_terms[i];
+      inv_eta_B += t.phi_i * pow_term(gap, t.alpha, eta_B_int_alpha_[i], lg, have);
+    }
   }
   // Linearly implicit E24 step with end-of-step tau_bar, gamma_dot^p: f = (f_n + dt H' f_m)/(1 + dt (H' + S')),
   // H' = K_0 gamma_dot^p (tau_bar/tau*)^{3/2}, S' = K_0 (gamma_dot^p + tau_bar/eta_B + xi_dot_eps); `stiff` = dt (H' + S').
@@ -541,10 +554,11 @@ GranularUpdate GranularLaw::update_impl(GranularState& state, const Eigen::Matri
     // the root nearest the staggered prediction is found; Illinois iteration.
     ReturnMap rz;
     double dummy = 0.0;
+    int structure_iterations = 0;  // a local, not out: out must not escape into the (out-of-line) lambda
     auto Z = [&](double ff, ReturnMap& rr, double& fnext) {
       rr = return_map(ff, phi, eta_0, dt, p_tr, tau_tr);
       fnext = f_next(rr, dummy);
-      out.structure_iterations++;
+      structure_iterations++;
       return ff - fnext;
     };
     double a_f = fn, Za = fn - f_new;  // Z(f_n) from the staggered solve
@@ -595,6 +609,7 @@ GranularUpdate GranularLaw::update_impl(GranularState& state, const Eigen::Matri
       }
     }
     r = rz;
+    out.structure_iterations = structure_iterations;
     r.converged = r.converged && ok;
     if (!ok) out.message = "implicit structure update did not converge within the iteration cap";
   }
@@ -634,8 +649,11 @@ GranularUpdate GranularLaw::update_impl(GranularState& state, const Eigen::Matri
   out.converged = r.converged;
 
   // ---- final stress: radial return in deviatoric space ----
-  Eigen::Matrix3d sig = (tau_tr > 0.0 ? tau / tau_tr : 0.0) * s_tr;
-  sig.diagonal().array() -= p;
+  // (element by element: the Eigen expression did not inline; same operations)
+  const double scale = tau_tr > 0.0 ? tau / tau_tr : 0.0;
+  Eigen::Matrix3d sig;
+  for (int i = 0; i < 9; ++i) sig.data()[i] = scale * s_tr.data()[i];
+  for (int i = 0; i < 3; ++i) sig(i, i) -= p;
 
   if (!finite3(sig) || !std::isfinite(f_new) || !std::isfinite(g) || !std::isfinite(p)) {
     out.finite = false;
@@ -643,7 +661,7 @@ GranularUpdate GranularLaw::update_impl(GranularState& state, const Eigen::Matri
     return out;
   }
   if (!out.converged && out.message == nullptr) out.message = "return map did not converge within the iteration cap";
-  state.sigma = sig;
+  for (int i = 0; i < 9; ++i) state.sigma.data()[i] = sig.data()[i];
   state.f = f_new;
   return out;
 }

@@ -13,7 +13,9 @@
 // tau_bar = |dev sigma|/sqrt(2); D, W the symmetric and skew parts of grad v_s [1/s].
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -156,6 +158,10 @@ class GranularLaw {
   GranularOptions options_;
   double eta_0_, G_, K_, mu_1_, mu_2_, b_, K_3_, K_0_, d2_rho_s_, tau_star_, xi_dot_eps_;
   double phi_c_, phi_j_, a_0_, a_inf_;
+  /// Per E8 term of steady_.eta_B_terms: the exponent alpha as an int when it is a whole number
+  /// <= 8 (evaluated by multiplication), else kNonInteger (exp(alpha log x)).
+  std::vector<int> eta_B_int_alpha_;
+  static constexpr int kNonInteger = std::numeric_limits<int>::min();
 };
 
 /// Tensor helpers shared with the driver and tests.
