@@ -49,6 +49,11 @@ GranularLaw::GranularLaw(const rheology::Preset& preset, GranularOptions options
   phi_j_ = steady_.phi_j;
   a_0_ = steady_.a_0;
   a_inf_ = steady_.a_inf;
+  for (const rheology::EtaBTerm& t : steady_.eta_B_terms) {
+    const double r = std::nearbyint(t.alpha);
+    // (a whole alpha < 0, which validation rejects, gives 1 as before: no multiplication)
+    eta_B_int_alpha_.push_back(r == t.alpha && r <= 8.0 ? static_cast<int>(std::max(r, 0.0)) : kNonInteger);
+  }
 }
 
 double GranularLaw::mu_q(double I_m) const {
@@ -59,12 +64,12 @@ double GranularLaw::mu_q(double I_m) const {
 
 namespace {
 
-/// x^alpha for alpha >= 0, with small integer exponents by multiplication (E8 is evaluated per call).
-inline double pow_term(double x, double alpha, double& log_x, bool& have_log) {
-  const double r = std::nearbyint(alpha);
-  if (r == alpha && r <= 8.0) {
+/// x^alpha for alpha >= 0, with small integer exponents by multiplication (E8 is evaluated per call);
+/// int_alpha: alpha as an int when it is a whole number <= 8, else INT_MIN (GranularLaw::kNonInteger).
+inline double pow_term(double x, double alpha, int int_alpha, double& log_x, bool& have_log) {
+  if (int_alpha != std::numeric_limits<int>::min()) {
     double y = 1.0;
-    for (int k = 0; k < static_cast<int>(r); ++k) y *= x;
+    for (int k = 0; k < int_alpha; ++k) y *= x;
     return y;
   }
   if (!have_log) {
@@ -74,7 +79,41 @@ inline double pow_term(double x, double alpha, double& log_x, bool& have_log) {
   return std::exp(alpha * log_x);
 }
 
-inline bool finite3(const Eigen::Matrix3d& m) { return m.allFinite(); }
+/// m.allFinite() without branches: x * 0 is NaN exactly when x is infinite or NaN.
+inline bool finite3(const Eigen::Matrix3d& m) {
+  const double* x = m.data();
+  double z = 0.0;
+  for (int i = 0; i < 9; ++i) z += x[i] * 0.0;
+  return z == 0.0;
+}
+
+/// E16 trial sig + dt (2 G D + W sig - sig W) + dt (K - 2G/3) tr(D) 1, written out so that it inlines.
+/// Every sum is formed in the order of the Eigen 3.4 expression it replaces (the SSE2 lazy product
+/// sums rows 0-1 as (k0 + k1) + k2 and row 2 as k0 + (k1 + k2); the trace is d00 + (d11 + d22)), so
+/// the result is the same bit for bit. (For W = skew(L), with its zero diagonal, the order is moot.)
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void jaumann_trial(const Eigen::Matrix3d& S, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W, double dt,
+                          double G, double K, Eigen::Matrix3d& r) {
+  const double two_G = 2.0 * G;
+  for (int j = 0; j < 3; ++j) {
+    for (int i = 0; i < 3; ++i) {
+      double ws, sw;
+      if (i < 2) {
+        ws = (W(i, 0) * S(0, j) + W(i, 1) * S(1, j)) + W(i, 2) * S(2, j);
+        sw = (S(i, 0) * W(0, j) + S(i, 1) * W(1, j)) + S(i, 2) * W(2, j);
+      } else {
+        ws = W(i, 0) * S(0, j) + (W(i, 1) * S(1, j) + W(i, 2) * S(2, j));
+        sw = S(i, 0) * W(0, j) + (S(i, 1) * W(1, j) + S(i, 2) * W(2, j));
+      }
+      r(i, j) = S(i, j) + dt * ((two_G * D(i, j) + ws) - sw);
+    }
+  }
+  const double trD = D(0, 0) + (D(1, 1) + D(2, 2));
+  const double vol = dt * (K - two_G / 3.0) * trD;
+  for (int i = 0; i < 3; ++i) r(i, i) += vol;
+}
 
 }  // namespace
 
@@ -227,37 +266,45 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
       // pressure balance p = p_tr + K dt beta(u) gamma_dot with p = Q(gamma_dot)/u^2 is a quadratic
       // in gamma_dot with one positive root; R(u) = tau_tr - G dt gamma_dot - (mu_p + beta) p is the
       // E21 residual (decreasing in u, see docs/granular.md).
+      // The value (g, p, R) and the derivatives (dg, dp, dR) are separate steps: the f_1 + f_3
+      // branch below needs only the value at u_eq.
       struct Eval {
         double g, dg, p, dp, R, dR;
+        double u, be, mq, disc, gv;  // intermediates of the value reused by the derivatives
       };
-      auto eval = [&](double uu) {
+      auto eval_value = [&](double uu) {
         Eval e{};
-        const double be = beta_of(uu), dbe = dbeta_of(uu);
+        e.u = uu;
+        e.be = beta_of(uu);
         const double A2 = d2_rho_s_;
-        const double B2 = two_eta - Kdt * be * uu * uu;
+        const double B2 = two_eta - Kdt * e.be * uu * uu;
         const double C2 = p_tr * uu * uu;
-        const double disc = std::sqrt(B2 * B2 + 4.0 * A2 * C2);
-        e.g = B2 >= 0.0 ? 2.0 * C2 / (B2 + disc) : (disc - B2) / (2.0 * A2);
-        const double dB2 = -Kdt * (dbe * uu * uu + 2.0 * be * uu);
-        const double dC2 = 2.0 * p_tr * uu;
-        e.dg = disc > 0.0 ? (dC2 - dB2 * e.g) / disc : 0.0;
-        e.p = p_tr + Kdt * be * e.g;
-        e.dp = Kdt * (dbe * e.g + be * e.dg);
-        const double mq = mu_q(uu);
-        const double dmq = b_ == 0.0 ? 0.0 : (mu_2_ - mu_1_) * b_ / ((uu + b_) * (uu + b_));
+        e.disc = std::sqrt(B2 * B2 + 4.0 * A2 * C2);
+        e.g = B2 >= 0.0 ? 2.0 * C2 / (B2 + e.disc) : (e.disc - B2) / (2.0 * A2);
+        e.p = p_tr + Kdt * e.be * e.g;
+        e.mq = mu_q(uu);
         // viscous friction term of E20 times p: (5/2) phi/a * I_v/I_m * p = visc * g/u
-        double gv = 0.0, dgv = 0.0;
-        if (uu > 0.0) {
-          gv = e.g / uu;
-          dgv = e.dg / uu - e.g / (uu * uu);
-        } else {
-          dgv = p_tr / two_eta;  // g ~ p_tr u^2/(2 eta_0) as u -> 0
-        }
-        e.R = tau_tr - Gdt * e.g - (mq + be) * e.p - visc * gv;
-        e.dR = -Gdt * e.dg - (dmq + dbe) * e.p - (mq + be) * e.dp - visc * dgv;
+        e.gv = uu > 0.0 ? e.g / uu : 0.0;
+        e.R = tau_tr - Gdt * e.g - (e.mq + e.be) * e.p - visc * e.gv;
         return e;
       };
-      const Eval e_lo = eval(u_eq);
+      auto eval_derivatives = [&](Eval& e) {
+        const double uu = e.u, be = e.be, dbe = dbeta_of(uu);
+        const double dB2 = -Kdt * (dbe * uu * uu + 2.0 * be * uu);
+        const double dC2 = 2.0 * p_tr * uu;
+        e.dg = e.disc > 0.0 ? (dC2 - dB2 * e.g) / e.disc : 0.0;
+        e.dp = Kdt * (dbe * e.g + be * e.dg);
+        const double dmq = b_ == 0.0 ? 0.0 : (mu_2_ - mu_1_) * b_ / ((uu + b_) * (uu + b_));
+        const double dgv = uu > 0.0 ? e.dg / uu - e.g / (uu * uu)
+                                    : p_tr / two_eta;  // g ~ p_tr u^2/(2 eta_0) as u -> 0
+        e.dR = -Gdt * e.dg - (dmq + dbe) * e.p - (e.mq + be) * e.dp - visc * dgv;
+      };
+      auto eval = [&](double uu) {
+        Eval e = eval_value(uu);
+        eval_derivatives(e);
+        return e;
+      };
+      Eval e_lo = eval_value(u_eq);
       if (e_lo.R <= 0.0 && u_eq > 0.0) {
         // -------- f_1 + f_3 (E21, E23 with K_4 = 0): beta = 0, I_m = u_eq; closed form ----------
         // tau_tr - G dt g = mu_q p + visc g/u_eq with p = Q(g)/u_eq^2: quadratic A g^2 + B g - C = 0.
@@ -275,6 +322,7 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
         regime = g > 0.0 ? GranularRegime::kShearCompaction : GranularRegime::kCompaction;
       } else {
         // -------- f_1 only: root of R(u) on [u_lo, u_hi] --------
+        eval_derivatives(e_lo);
         double lo = u_eq, hi;
         // Upper bracket: with beta >= 0, gamma_dot(u) >= the beta = 0 root, so gamma_dot(u_hi) >= gamma_max
         // when Q(gamma_max)/u_hi^2 <= p_tr; there R <= -(mu_p + beta) p < 0.
@@ -431,6 +479,22 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
 
 GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
                                    double dt, double phi, double eta_0) const {
+  return update_impl<true>(state, D, W, dt, phi, eta_0);
+}
+
+GranularStep GranularLaw::advance(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
+                                  double dt, double phi) const {
+  const GranularUpdate u = update_impl<false>(state, D, W, dt, phi, eta_0_);
+  return GranularStep{u.regime, u.ok(), u.gamma_dot_p};
+}
+
+// Inlined into update() and advance(), so that advance() drops the stores of what it does not return.
+template <bool kDiagnostics>
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline GranularUpdate GranularLaw::update_impl(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
+                                        double dt, double phi, double eta_0) const {
   GranularUpdate out;
   out.f_old = state.f;
   // ---- input checks (never throw in the hot loop; report instead) ----
@@ -445,11 +509,9 @@ GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& 
   out.jammed = phi >= phi_j_;
 
   // ---- E16: elastic trial (D^p = 0), explicit Jaumann rotation with sigma_n ----
-  const double trD = D.trace();
-  Eigen::Matrix3d sig_tr = state.sigma + dt * (2.0 * G_ * D + W * state.sigma - state.sigma * W);
-  sig_tr.diagonal().array() += dt * (K_ - 2.0 * G_ / 3.0) * trD;
-  const double p_tr = -sig_tr.trace() / 3.0;
-  Eigen::Matrix3d s_tr = sig_tr;
+  Eigen::Matrix3d s_tr;  // the trial stress, then its deviator
+  jaumann_trial(state.sigma, D, W, dt, G_, K_, s_tr);
+  const double p_tr = -s_tr.trace() / 3.0;
   s_tr.diagonal().array() += p_tr;  // dev sigma_tr
   const double tau_tr = std::sqrt(0.5 * s_tr.squaredNorm());
   out.tau_trial = tau_tr;
@@ -461,7 +523,10 @@ GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& 
   if (const double gap = phi_j_ - phi; gap > 0.0) {
     double lg = 0.0;
     bool have = false;
-    for (const rheology::EtaBTerm& t : steady_.eta_B_terms) inv_eta_B += t.phi_i * pow_term(gap, t.alpha, lg, have);
+    for (std::size_t i = 0; i < steady_.eta_B_terms.size(); ++i) {
+      const rheology::EtaBTerm& t = steady_.eta_B_terms[i];
+      inv_eta_B += t.phi_i * pow_term(gap, t.alpha, eta_B_int_alpha_[i], lg, have);
+    }
   }
   // Linearly implicit E24 step with end-of-step tau_bar, gamma_dot^p: f = (f_n + dt H' f_m)/(1 + dt (H' + S')),
   // H' = K_0 gamma_dot^p (tau_bar/tau*)^{3/2}, S' = K_0 (gamma_dot^p + tau_bar/eta_B + xi_dot_eps); `stiff` = dt (H' + S').
@@ -489,10 +554,11 @@ GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& 
     // the root nearest the staggered prediction is found; Illinois iteration.
     ReturnMap rz;
     double dummy = 0.0;
+    int structure_iterations = 0;  // a local, not out: out must not escape into the (out-of-line) lambda
     auto Z = [&](double ff, ReturnMap& rr, double& fnext) {
       rr = return_map(ff, phi, eta_0, dt, p_tr, tau_tr);
       fnext = f_next(rr, dummy);
-      out.structure_iterations++;
+      structure_iterations++;
       return ff - fnext;
     };
     double a_f = fn, Za = fn - f_new;  // Z(f_n) from the staggered solve
@@ -543,6 +609,7 @@ GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& 
       }
     }
     r = rz;
+    out.structure_iterations = structure_iterations;
     r.converged = r.converged && ok;
     if (!ok) out.message = "implicit structure update did not converge within the iteration cap";
   }
@@ -557,7 +624,9 @@ GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& 
   out.gamma_dot_p = g;
   out.xi_dot_1 = r.xi1;
   out.xi_dot_2 = r.xi2;
-  if (p > 0.0 && g > 0.0) {
+  if constexpr (!kDiagnostics) {
+    (void)a;
+  } else if (p > 0.0 && g > 0.0) {
     out.I_v = eta_0 * g / p;                      // E19
     out.I = g * granular_.d * std::sqrt(granular_.rho_s / p);
     out.I_m = std::sqrt(out.I * out.I + 2.0 * out.I_v);
@@ -580,8 +649,11 @@ GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& 
   out.converged = r.converged;
 
   // ---- final stress: radial return in deviatoric space ----
-  Eigen::Matrix3d sig = (tau_tr > 0.0 ? tau / tau_tr : 0.0) * s_tr;
-  sig.diagonal().array() -= p;
+  // (element by element: the Eigen expression did not inline; same operations)
+  const double scale = tau_tr > 0.0 ? tau / tau_tr : 0.0;
+  Eigen::Matrix3d sig;
+  for (int i = 0; i < 9; ++i) sig.data()[i] = scale * s_tr.data()[i];
+  for (int i = 0; i < 3; ++i) sig(i, i) -= p;
 
   if (!finite3(sig) || !std::isfinite(f_new) || !std::isfinite(g) || !std::isfinite(p)) {
     out.finite = false;
@@ -589,7 +661,7 @@ GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& 
     return out;
   }
   if (!out.converged && out.message == nullptr) out.message = "return map did not converge within the iteration cap";
-  state.sigma = sig;
+  for (int i = 0; i < 9; ++i) state.sigma.data()[i] = sig.data()[i];
   state.f = f_new;
   return out;
 }

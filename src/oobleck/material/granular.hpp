@@ -13,7 +13,9 @@
 // tau_bar = |dev sigma|/sqrt(2); D, W the symmetric and skew parts of grad v_s [1/s].
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -67,6 +69,14 @@ struct GranularUpdate {
   bool ok() const { return converged && finite; }
 };
 
+/// What the MPM hot loop needs from one update (GranularLaw::advance): the fields of GranularUpdate
+/// that do not need the E18-E20 end-state diagnostics.
+struct GranularStep {
+  GranularRegime regime = GranularRegime::kElastic;
+  bool ok = true;            ///< GranularUpdate::ok(): converged and finite
+  double gamma_dot_p = 0.0;  ///< plastic shear rate (E17) [1/s]
+};
+
 /// What the law does for phi >= phi_j (jammed: phi_m(f) <= phi for every f, no compaction).
 enum class JammedStructure : std::uint8_t {
   kEvolve,    ///< E24 continues unchanged with f_m(phi) from E9 (continuous in phi; default)
@@ -104,6 +114,12 @@ class GranularLaw {
   GranularUpdate update(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W, double dt,
                         double phi, double eta_0) const;
 
+  /// Hot-loop form of update() (preset eta_0): the same state update, bit for bit, without the
+  /// E18-E20 diagnostics of the end state (I_v, I, I_m, phi_eq, beta, mu_p) that the MPM adapter does
+  /// not use. On failure call update() on the state before for the diagnosis.
+  GranularStep advance(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W, double dt,
+                       double phi) const;
+
   /// Throws NumericalError with describe() unless u.ok().
   void require_ok(const GranularUpdate& u, const GranularState& before, const Eigen::Matrix3d& D,
                   const Eigen::Matrix3d& W, double dt, double phi) const;
@@ -131,6 +147,9 @@ class GranularLaw {
     bool converged = true;
     int iterations = 0;
   };
+  template <bool kDiagnostics>
+  GranularUpdate update_impl(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W, double dt,
+                             double phi, double eta_0) const;
   /// E17–E23 at structure f for a given trial (p_tr, tau_tr): allocation-free, never throws.
   ReturnMap return_map(double f, double phi, double eta_0, double dt, double p_tr, double tau_tr) const;
 
@@ -139,6 +158,10 @@ class GranularLaw {
   GranularOptions options_;
   double eta_0_, G_, K_, mu_1_, mu_2_, b_, K_3_, K_0_, d2_rho_s_, tau_star_, xi_dot_eps_;
   double phi_c_, phi_j_, a_0_, a_inf_;
+  /// Per E8 term of steady_.eta_B_terms: the exponent alpha as an int when it is a whole number
+  /// <= 8 (evaluated by multiplication), else kNonInteger (exp(alpha log x)).
+  std::vector<int> eta_B_int_alpha_;
+  static constexpr int kNonInteger = std::numeric_limits<int>::min();
 };
 
 /// Tensor helpers shared with the driver and tests.

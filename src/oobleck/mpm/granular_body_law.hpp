@@ -42,16 +42,25 @@ class GranularBodyLaw final : public StressLaw<G> {
     std::int64_t first_bad = std::numeric_limits<std::int64_t>::max();
 #pragma omp parallel for schedule(static) reduction(min : first_bad)
     for (std::int64_t q = 0; q < np; ++q) {
-      const Mat3& L = body.L_1_s[q];
-      const Mat3 D = 0.5 * (L + L.transpose());
-      const Mat3 W = 0.5 * (L - L.transpose());
-      material::GranularState st{body.stress_Pa[q], f[q]};
-      const material::GranularUpdate u = law_.update(st, D, W, dt_s, phi_of(body, q));
-      if (!u.ok()) {
+      // Element by element (same values as 0.5 (L +- L^T) and plain copies): GCC compiled the Eigen
+      // forms into an out-of-line assignment loop and rep-movs block copies.
+      const double* L = body.L_1_s[q].data();
+      Mat3 D, W;
+      for (int j = 0; j < 3; ++j) {
+        for (int i = 0; i < 3; ++i) {
+          D(i, j) = 0.5 * (L[i + 3 * j] + L[j + 3 * i]);
+          W(i, j) = 0.5 * (L[i + 3 * j] - L[j + 3 * i]);
+        }
+      }
+      material::GranularState st;
+      copy9(body.stress_Pa[q], st.sigma);
+      st.f = f[q];
+      const material::GranularStep u = law_.advance(st, D, W, dt_s, phi_of(body, q));
+      if (!u.ok) {
         first_bad = std::min(first_bad, q);
         continue;
       }
-      body.stress_Pa[q] = st.sigma;
+      copy9(st.sigma, body.stress_Pa[q]);
       f[q] = st.f;
       regime[q] = static_cast<std::uint8_t>(u.regime);
       gamma_dot_p[q] = u.gamma_dot_p;
@@ -86,6 +95,10 @@ class GranularBodyLaw final : public StressLaw<G> {
   std::vector<double> gamma_dot_p;       ///< plastic shear rate of the last step [1/s]
 
  private:
+  static void copy9(const Mat3& from, Mat3& to) {
+    for (int i = 0; i < 9; ++i) to.data()[i] = from.data()[i];
+  }
+
   material::GranularLaw law_;
   double rho_s_, G_, K_;
 };
