@@ -12,6 +12,7 @@
 #include "oobleck/core/error.hpp"
 #include "oobleck/io/checkpoint.hpp"
 #include "oobleck/io/csv.hpp"
+#include "oobleck/run/finite_check.hpp"
 #include "oobleck/run/runner.hpp"
 #include "oobleck/scene/config.hpp"
 
@@ -137,4 +138,25 @@ TEST(RunScenes, InvalidScenesAreRefusedBeforeAnyOutput) {
     EXPECT_NE(r.output.find("bad.toml"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(d / "out")) << c.message;
   }
+}
+
+TEST(RunScenes, NonFiniteGuardFindsTheFirstBadPointAndWhatIsBad) {
+  mpm::Body<mpm::PlaneStrain> b;
+  b.name = "grains";
+  for (int p = 0; p < 1000; ++p) b.add_point(mpm::Vec<2>(0.001 * p, 0.0), 1e-6, 1000.0);
+  EXPECT_FALSE(run::first_non_finite(b).has_value());
+  b.stress_Pa[700](1, 2) = NAN;
+  b.v_m_s[900][1] = INFINITY;
+  b.stress_Pa[901](0, 0) = 1e308;
+  b.stress_Pa[901](1, 1) = 1e308;  // finite parts, infinite sum
+  auto bad = run::first_non_finite(b);
+  ASSERT_TRUE(bad.has_value());
+  EXPECT_EQ(bad->point, 700);
+  EXPECT_STREQ(bad->what, "stress");
+  b.stress_Pa[700](1, 2) = 0.0;
+  bad = run::first_non_finite(b);
+  EXPECT_EQ(bad->point, 900);
+  EXPECT_STREQ(bad->what, "velocity");
+  b.v_m_s[900][1] = 0.0;
+  EXPECT_STREQ(run::first_non_finite(b)->what, "state (overflow of finite values)");
 }

@@ -26,6 +26,7 @@
 #include "oobleck/mpm/initial_state.hpp"
 #include "oobleck/mpm/laws.hpp"
 #include "oobleck/mpm/solver.hpp"
+#include "oobleck/run/finite_check.hpp"
 #include "oobleck/run/third_bodies.hpp"
 
 namespace oobleck::run {
@@ -470,25 +471,12 @@ void SceneRun<G>::write_due_snapshots(bool final_step) {
 template <class G>
 void SceneRun<G>::check_finite() const {
   for (int b = 0; b < solver_->body_count(); ++b) {
-    auto& body = solver_->body(b);
-    const std::int64_t n = body.size();
-    std::int64_t bad = std::numeric_limits<std::int64_t>::max();
-#pragma omp parallel for schedule(static) reduction(min : bad)
-    for (std::int64_t p = 0; p < n; ++p) {
-      if (!body.x_m[p].allFinite() || !body.v_m_s[p].allFinite() || !body.stress_Pa[p].allFinite() ||
-          !std::isfinite(body.volume_m3[p])) {
-        bad = std::min(bad, p);
-      }
-    }
-    if (bad != std::numeric_limits<std::int64_t>::max()) {
-      const char* what = !body.x_m[bad].allFinite()        ? "position"
-                         : !body.v_m_s[bad].allFinite()     ? "velocity"
-                         : !body.stress_Pa[bad].allFinite() ? "stress"
-                                                            : "volume";
+    const auto& body = solver_->body(b);
+    if (const auto bad = first_non_finite(body)) {
       throw NumericalError(fmt::format(
           "non-finite {} at step {} (t = {:.6g} s): body '{}' (law: {}), point {}; stopping before any output "
           "of this step is written",
-          what, solver_->steps(), solver_->time_s(), body.name, body.law ? body.law->name() : "none", bad));
+          bad->what, solver_->steps(), solver_->time_s(), body.name, body.law ? body.law->name() : "none", bad->point));
     }
   }
 }
