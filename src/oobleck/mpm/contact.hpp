@@ -226,6 +226,26 @@ void scatter_mass_gradient_and_volume(const Body<G>& body, const ShapeCache<G::d
   }
 }
 
+/// Nodal mass gradient ∇m_i = Σ_p m_p ∇N_ip of the points of `body` that lie within `half` of
+/// `centre` along every axis (minimum image on periodic axes); the others are skipped. Used for
+/// the mixture's gradient, which contact reads only at nodes where a solid has mass: with the box
+/// around the solids' points grown by two kernel widths, every point that reaches such a node is
+/// inside, in the same order, so those nodes get exactly the full scatter's values.
+template <class G, int K>
+void scatter_mass_gradient_near(const Body<G>& body, const ShapeCache<G::dim>& cache, const Grid<G::dim>& grid,
+                                const Vec<G::dim>& centre, const Vec<G::dim>& half, std::vector<Vec<G::dim>>& grad) {
+  constexpr int D = G::dim;
+  for (auto& g : grad) g.setZero();
+  const std::int64_t np = body.size();
+  for (std::int64_t p = 0; p < np; ++p) {
+    const Vec<D> d = periodic_difference<D>(grid, body.x_m[p], centre);
+    if ((d.cwiseAbs().array() > half.array()).any()) continue;
+    const double m = body.mass_kg[p];
+    const std::int64_t o = p * K;
+    for (int k = 0; k < K; ++k) grad[cache.node[o + k]] += m * cache.grad[o + k];
+  }
+}
+
 /// Contact impulses at one node (model.md §8; the algorithm is in the header comment).
 /// n: unit outward normal of the solid; m_b = +∞ (std::isinf) for a prescribed body; m_s or m_f
 /// = 0 for a phase absent at the node. Returns the impulses on the grains (J_s) and the fluid

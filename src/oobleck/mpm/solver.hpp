@@ -370,7 +370,31 @@ class Solver {
     bool combined = false;
     for (const auto& c : contacts_) combined = combined || c.combined_normal;
     const int mix = grains_ >= 0 ? grains_ : fluid_;
-    if (mix >= 0 && (combined || !fluid)) {  // mixture mass gradient and/or volume
+    if (mix >= 0 && fluid && combined) {
+      // Mixture mass gradient only (the fluid gives the volume), from the mixture points near
+      // the solids: a box around all contact solids' points, grown by two kernel widths.
+      mixture_gradient_.resize(contact_weight_.size());
+      Vec<D> lo = Vec<D>::Constant(INFINITY), hi = Vec<D>::Constant(-INFINITY), ref = Vec<D>::Zero();
+      bool any = false;
+      for (const auto& c : contacts_) {
+        const auto& sb = *bodies_[c.solid];
+        for (std::int64_t p = 0; p < sb.size(); ++p) {
+          if (!any) ref = sb.x_m[p];
+          any = true;
+          const Vec<D> d = periodic_difference<D>(grid_, sb.x_m[p], ref);
+          lo = lo.cwiseMin(d);
+          hi = hi.cwiseMax(d);
+        }
+      }
+      if (any) {
+        const double margin = 2.0 * kernel_support(opt_.shape) * grid_.h_m;
+        const Vec<D> centre = ref + 0.5 * (lo + hi);
+        const Vec<D> half = 0.5 * (hi - lo) + Vec<D>::Constant(margin);
+        scatter_mass_gradient_near<G, K>(*bodies_[mix], caches_[mix], grid_, centre, half, mixture_gradient_);
+      } else {
+        for (auto& g : mixture_gradient_) g.setZero();
+      }
+    } else if (mix >= 0 && (combined || !fluid)) {  // mixture mass gradient and/or volume
       mixture_volume_.resize(contact_weight_.size());
       mixture_gradient_.resize(contact_weight_.size());
       scatter_mass_gradient_and_volume<G, K>(*bodies_[mix], caches_[mix], combined ? &mixture_gradient_ : nullptr,
