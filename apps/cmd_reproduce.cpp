@@ -122,11 +122,22 @@ void annular(Reproduction& r) {
   double vmax = 0;
   for (double v : prof.back()["v_over_ui"].get<std::vector<double>>()) vmax = std::max(vmax, v);
   r.claims.push_back({"S1 fast bob: band co-rotating with the bob grows outward", "rigid band, front at near-constant speed",
-                      fmt::format("max v/u_i = {:.2f} at {:.2f} rad; front speed {:.3g} m/s (R^2 {:.3f})", vmax,
+                      fmt::format("max v/u_i = {:.2f} at {:.2f} rad; front speed {:.3g} m/s (R^2 {:.3f}) up to r = {:.1f} mm", vmax,
                                   prof.back()["angle"].get<double>(),
                                   s["front_speed"].is_null() ? NAN : s["front_speed"].get<double>(),
-                                  s.contains("front_fit") ? s["front_fit"]["r_squared"].get<double>() : NAN),
+                                  s.contains("front_fit") ? s["front_fit"]["r_squared"].get<double>() : NAN,
+                                  s.contains("front_farthest") ? 1e3 * s["front_farthest"].get<double>() : NAN),
                       vmax > 1.0 ? "band forms (not fully rigid: v/(omega r) < 1 inside)" : "OFF"});
+  // "All flow stops when it reaches the outer wall": the outer half's rotation after its peak.
+  const auto& arrest = s["outer_arrest"];
+  const bool arrested = arrest["time"].is_number();
+  r.claims.push_back({"S1 fast bob: flow stops once the band reaches the outer wall",
+                      "all flow stops",
+                      fmt::format("outer half's rotation / omega_bob: peak {:.2f} at {:.3f} s, {:.2f} at the end; below 10% of "
+                                  "the peak {}; the layer at the bob (prescribed speed) keeps shearing",
+                                  arrest["peak"].get<double>(), arrest["peak_time"].get<double>(), arrest["final"].get<double>(),
+                                  arrested ? fmt::format("from {:.3f} s", arrest["time"].get<double>()) : std::string("never")),
+                      arrested ? "outer half arrested" : "OFF: outer half still turning"});
   // Slow bob: 0.31 rad of rotation takes 4.6 s at 0.84 mm/s; --quick: 2 mm grid up to 0.1 rad.
   const std::string qs = r.quick ? " --set grid.cell_size=0.002 --set duration=1.55" : " --set duration=4.7";
   r.oobleck(fmt::format("run {}/scenes/paper/annular_shear.toml --out {}/annular_slow --quiet --set u_inner=0.00084{}{}",

@@ -37,6 +37,17 @@ if s.get("front_speed") is not None:
              label=f"fit: {s['front_speed'] * 1e3:.0f} mm/s (R² {fit['r_squared']:.3f})")
     ax2.legend(fontsize=8)
 ax2.axhline(ro * 1e3, color="k", lw=0.8)
+if "outer_rotation" in s:
+    # The outer half's mean rotation relative to the bob (0 = at rest): its arrest after the band
+    # reaches the outer wall.
+    o = s["outer_rotation"]
+    ax3 = ax2.twinx()
+    ax3.plot([t * 1e3 for t in o["time"]], o["value"], "g-", lw=1)
+    ax3.set_ylabel("outer half: mean v_θ/(ω_bob r)", color="g")
+    ax3.set_ylim(0.0, 1.0)
+    arrest = s.get("outer_arrest", {})
+    if arrest.get("time") is not None:
+        ax3.axvline(arrest["time"] * 1e3, color="g", ls=":", lw=0.8)
 ax2.set_xlabel("t [ms]")
 ax2.set_ylabel("jammed front radius [mm] (v_θ/(ω r) = 0.5)")
 ax2.set_title(f"{s['scene']}: {p['cells'][0]}×{p['cells'][1]} cells of {p['cell_size'] * 1e3:g} mm", fontsize=9)

@@ -154,6 +154,37 @@ TEST(AnnularShear, FlowStopsWhenTheGapComesToRest) {
                    .time_s.has_value());
 }
 
+TEST(AnnularShear, OuterHalfRotationAndItsArrest) {
+  // Rigid rotation at a fraction s(t) of the bob's angular velocity: the outer half's rotation is
+  // s(t) exactly. s rises to 0.6 at t = 0.5 s, then falls linearly to 0 at t = 1 s: below 10% of
+  // the peak (0.06) first at the frame after t = 0.95 s, i.e. t = 0.96 s (frames every 0.04 s).
+  const double omega = kUi / kR0;
+  auto s_of_t = [](double t) { return t <= 0.5 ? 1.2 * t : 0.6 * (1.0 - t) / 0.5; };
+  std::vector<ShearFrame> frames;
+  for (int k = 0; k <= 25; ++k) {
+    ShearFrame fr;
+    fr.time_s = 0.04 * k;
+    fr.v_theta = grid();
+    for (std::size_t j = 0; j < fr.v_theta.ny; ++j)
+      for (std::size_t i = 0; i < fr.v_theta.nx; ++i) fr.v_theta.at(i, j) = s_of_t(fr.time_s) * omega * fr.v_theta.x(i);
+    frames.push_back(fr);
+  }
+  const TimeSeries outer = outer_rotation_series(frames, geometry());
+  ASSERT_EQ(outer.size(), frames.size());
+  for (std::size_t k = 0; k < outer.size(); ++k) EXPECT_NEAR(outer.value[k], s_of_t(frames[k].time_s), 1e-12);
+  const OuterArrest a = outer_arrest(outer, 0.1);
+  EXPECT_NEAR(a.peak, 0.6 * 0.48 / 0.5, 1e-12);  // the frame nearest the peak: t = 0.48 s (s = 0.576)
+  EXPECT_NEAR(a.peak_time_s, 0.48, 1e-12);
+  ASSERT_TRUE(a.arrest_time_s.has_value());
+  EXPECT_NEAR(*a.arrest_time_s, 0.96, 1e-12);  // s(0.96) = 0.048 < 0.0576; s(0.92) = 0.096
+  EXPECT_NEAR(a.final_value, 0.0, 1e-12);
+  // Without the fall there is no arrest; the band of RigidBandGrowsAtAKnownSpeed never reaches
+  // the outer half (r >= 30.5 mm) in its first frame, so that frame's rotation is 0.
+  EXPECT_FALSE(outer_arrest(TimeSeries{{0.0, 1.0}, {0.1, 0.2}}).arrest_time_s.has_value());
+  EXPECT_NEAR(outer_rotation_series({band_frame(0.0, kR0 + 2e-3)}, geometry()).value[0], 0.0, 1e-15);
+  EXPECT_THROW(outer_arrest(outer, 1.5), InputError);
+}
+
 TEST(AnnularShear, RejectsBadInput) {
   std::vector<ShearFrame> frames{band_frame(0.0, 0.02), band_frame(0.0, 0.021)};
   EXPECT_THROW(jammed_front_series(frames, geometry()), InputError);  // equal times

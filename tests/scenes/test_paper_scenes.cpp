@@ -43,6 +43,64 @@ TEST(PaperScenes, AnnularShearFastBobGrowsAJammedCoRotatingBand) {
   EXPECT_GT(s["front_speed"].get<double>(), 2 * 0.084);
 }
 
+TEST(PaperScenes, AnnularShearOuterHalfArrestsAfterTheBandStops) {
+  // S1 fast bob on a 2 mm grid for 0.1 s (0.67 rad): the band grows, the outer half of the gap,
+  // first dragged along (its mean rotation reaches a good fraction of the bob's), then comes
+  // almost to rest (below 10% of that peak) while the bob keeps turning. Measured at 1 mm:
+  // peak 0.36 at 51 ms, arrest at 66 ms, front farthest at r = 34.8 mm (docs/results.md).
+  clitest::TempDir d;
+  const auto s = run_paper_scene("annular_shear.toml", d / "run", {"grid.cell_size=0.002", "duration=0.1"});
+  const auto& a = s["outer_arrest"];
+  std::printf("[ measured ] coarse annular: outer rotation peak %.3f at %.3f s, arrest at %s s, front farthest %.4f m\n",
+              a["peak"].get<double>(), a["peak_time"].get<double>(), a["time"].dump().c_str(),
+              s["front_farthest"].get<double>());
+  EXPECT_GT(a["peak"].get<double>(), 0.2);
+  ASSERT_TRUE(a["time"].is_number());
+  EXPECT_GT(a["time"].get<double>(), a["peak_time"].get<double>());
+  // The front advanced steadily before: fitted up to its farthest extent.
+  EXPECT_GT(s["front_fit"]["r_squared"].get<double>(), 0.95);
+  EXPECT_GT(s["front_speed"].get<double>(), 2 * 0.084);
+  const auto prof = s["profiles"];
+  ASSERT_EQ(prof.size(), 6u);  // 0, 0.1, 0.2, 0.31, 0.45, 0.6 rad
+}
+
+TEST(PaperScenes, FastWheelRidesHigherAndTravelsFurtherThanTheSlowOne) {
+  // S4 on a 50 x 25 grid for 1 s, same parameters, only omega changes (the coarse grid of
+  // `reproduce --quick`): at 1 rad/s the wheel sinks below the bed surface and hardly moves; at
+  // 10 rad/s the paddles jam the material they strike: it ends higher and travels forward.
+  clitest::TempDir d;
+  const std::vector<std::string> coarse{"cells=[50,25]", "time.dt=2e-4", "duration=1.0"};
+  auto with = [&](const std::string& omega) {
+    auto sets = coarse;
+    sets.push_back("omega=" + omega);
+    return sets;
+  };
+  const auto fast = run_paper_scene("wheel.toml", d / "fast", with("10"));
+  const auto slow = run_paper_scene("wheel.toml", d / "slow", with("1"));
+  std::printf("[ measured ] coarse wheel: omega 10: hub %.3f m, distance %.3f m; omega 1: hub %.3f m, distance %.3f m\n",
+              fast["hub_height_final"].get<double>(), fast["distance"].get<double>(),
+              slow["hub_height_final"].get<double>(), slow["distance"].get<double>());
+  const double surface = slow["bed_surface"].get<double>();
+  EXPECT_NEAR(surface, 0.5, 0.02);
+  EXPECT_LT(slow["hub_height_final"].get<double>(), surface);  // the slow wheel sinks
+  EXPECT_GT(fast["hub_height_final"].get<double>(), slow["hub_height_final"].get<double>() + 0.02);
+  EXPECT_GT(fast["distance"].get<double>(), 0.2);
+  EXPECT_GT(fast["distance"].get<double>(), 5.0 * std::abs(slow["distance"].get<double>()));
+  // The motor held the mean angular velocity (after spin-up).
+  const auto tw = fast["omega_measured"]["time"].get<std::vector<double>>();
+  const auto w = fast["omega_measured"]["value"].get<std::vector<double>>();
+  double sum = 0.0;
+  int n = 0;
+  for (std::size_t k = 0; k < w.size(); ++k) {
+    if (tw[k] > 0.1) {
+      sum += w[k];
+      ++n;
+    }
+  }
+  ASSERT_GT(n, 10);
+  EXPECT_NEAR(sum / n, 10.0, 0.5);
+}
+
 TEST(PaperScenes, IntruderDrivesAGrowingPlugWithFrontRatioNearTwo) {
   // S3 on a 2.5 mm grid for 10 ms (v0 = 0.2 m/s, phi = 0.47): material below the intruder moves
   // with it (u_z >= 0.5 v0) over a region that grows ahead of the tip and sideways past its edge.

@@ -245,4 +245,51 @@ FlowStop flow_stop_time(const std::vector<ShearFrame>& frames, const AnnularGeom
   return out;
 }
 
+TimeSeries outer_rotation_series(const std::vector<ShearFrame>& frames, const AnnularGeometry& geometry) {
+  check_frames(frames, geometry, "outer_rotation_series");
+  const GridField2D& grid = frames.front().v_theta;
+  const double eps = 1e-9 * grid.h;
+  const double r_mid = 0.5 * (geometry.bob_radius_m + geometry.outer_radius_m);
+  std::vector<std::size_t> nodes;
+  for (std::size_t i = 0; i < grid.nx; ++i) {
+    const double r = grid.x(i);
+    if (r >= r_mid - eps && r < geometry.outer_radius_m - eps) nodes.push_back(i);
+  }
+  if (nodes.empty())
+    throw InputError(fmt::format("outer_rotation_series: no node in the outer half [{}, {}) m of the gap", r_mid,
+                                 geometry.outer_radius_m));
+  const double omega_bob = geometry.bob_speed_m_per_s / geometry.bob_radius_m;
+  TimeSeries out;
+  for (const ShearFrame& fr : frames) {
+    const std::vector<double> row = fr.v_theta.row_at(geometry.sample_z_m, "outer_rotation_series: sample z");
+    double sum = 0.0;
+    for (const std::size_t i : nodes) sum += row[i] / (omega_bob * grid.x(i));
+    out.time.push_back(fr.time_s);
+    out.value.push_back(sum / static_cast<double>(nodes.size()));
+  }
+  return out;
+}
+
+OuterArrest outer_arrest(const TimeSeries& outer_rotation, double fraction) {
+  outer_rotation.validate("outer_arrest: outer rotation series");
+  if (!(std::isfinite(fraction) && fraction > 0.0 && fraction < 1.0))
+    throw InputError(fmt::format("outer_arrest: fraction = {} must lie in (0, 1)", fraction));
+  OuterArrest a;
+  a.fraction = fraction;
+  const auto& v = outer_rotation.value;
+  const std::size_t k_peak = static_cast<std::size_t>(std::max_element(v.begin(), v.end()) - v.begin());
+  a.peak = v[k_peak];
+  a.peak_time_s = outer_rotation.time[k_peak];
+  a.final_value = v.back();
+  if (a.peak > 0.0) {
+    for (std::size_t k = k_peak + 1; k < v.size(); ++k) {
+      if (v[k] < fraction * a.peak) {
+        a.arrest_time_s = outer_rotation.time[k];
+        break;
+      }
+    }
+  }
+  return a;
+}
+
 }  // namespace oobleck::analysis

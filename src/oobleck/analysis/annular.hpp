@@ -99,4 +99,23 @@ struct FlowStop {
 FlowStop flow_stop_time(const std::vector<ShearFrame>& frames, const AnnularGeometry& geometry,
                         double speed_tolerance_m_per_s, double wall_margin_m = 0.0, double threshold = 0.5);
 
+/// Rotation of the outer half of the gap relative to the bob: along z = sample_z_m, the mean of
+/// v_theta / (omega_bob r) over the nodes with (r_0 + r_o)/2 <= r < r_o (the wall node excluded),
+/// in every frame. 1 = co-rotating rigidly with the bob, 0 = at rest. Throws InputError when
+/// the outer half holds no node.
+TimeSeries outer_rotation_series(const std::vector<ShearFrame>& frames, const AnnularGeometry& geometry);
+
+/// Arrest of the outer half after the jammed band reaches the outer wall (S1: "all flow stops
+/// when it reaches the outer wall", with the bob's speed prescribed the layer at the bob keeps
+/// shearing): the peak of the outer rotation and its time, and the first later time at which it
+/// has fallen below `fraction` of that peak (nullopt when it never does or the peak is <= 0).
+struct OuterArrest {
+  double peak = 0.0;                   ///< max of the outer rotation [-]
+  double peak_time_s = 0.0;
+  double final_value = 0.0;            ///< outer rotation in the last frame [-]
+  double fraction = 0.1;               ///< the criterion used
+  std::optional<double> arrest_time_s;
+};
+OuterArrest outer_arrest(const TimeSeries& outer_rotation, double fraction = 0.1);
+
 }  // namespace oobleck::analysis

@@ -88,6 +88,14 @@ nlohmann::json to_json(const FlowStop& stop) {
           {"by_front", stop.by_front}};
 }
 
+nlohmann::json to_json(const OuterArrest& a) {
+  return {{"peak", num(a.peak)},
+          {"peak_time", num(a.peak_time_s)},
+          {"final", num(a.final_value)},
+          {"fraction", num(a.fraction)},
+          {"time", a.arrest_time_s ? num(*a.arrest_time_s) : nlohmann::json(nullptr)}};
+}
+
 nlohmann::json to_json(const WheelSummary& s, const WheelCriteria& c) {
   return {{"hub_height_initial", num(s.hub_height_initial_m)},
           {"hub_height_final", num(s.hub_height_final_m)},

@@ -30,6 +30,7 @@ nlohmann::json to_json(const DepthProfile& profile);
 nlohmann::json to_json(const std::vector<ShearProfile>& profiles);
 /// {time: [s] or null, by_velocity, by_front}
 nlohmann::json to_json(const FlowStop& stop);
+nlohmann::json to_json(const OuterArrest& arrest);
 /// {hub_height_initial, hub_height_final, hub_height_min, hub_height_min_time, height_loss,
 ///  bed_surface, wheel_radius, distance, duration, mean_forward_speed, stays_at_surface, sinks,
 ///  ever_below_surface}

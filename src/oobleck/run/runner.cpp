@@ -1,5 +1,6 @@
 #include "oobleck/run/runner.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -937,7 +938,8 @@ nlohmann::json SceneRun<G>::analysis_result() const {
     const auto geo = annular_geometry();
     std::vector<double> angles;
     const double max_angle = geo.bob_speed_m_per_s * shear_frames_.back().time_s / geo.bob_radius_m;
-    for (double th : {0.0, 0.1, 0.2, 0.31}) {
+    // The paper's angles, then later ones in longer runs (the arrest after the band reaches the wall).
+    for (double th : {0.0, 0.1, 0.2, 0.31, 0.45, 0.6, 0.8, 1.0}) {
       if (th <= max_angle) angles.push_back(th);
     }
     const auto profiles = analysis::surface_profiles(shear_frames_, geo, angles);
@@ -948,9 +950,21 @@ nlohmann::json SceneRun<G>::analysis_result() const {
     a["bob_angle_final_rad"] = max_angle;
     const auto fronts = analysis::jammed_front_series(shear_frames_, geo);
     a["front"] = analysis::to_json(analysis::front_radius_series(fronts));
+    // The front speed is fitted while the front advances: up to its farthest extent (after the
+    // band reaches the outer wall's influence the front criterion recedes, see docs/results.md).
+    const auto radii = analysis::front_radius_series(fronts);
+    double t_farthest = INFINITY;
+    if (radii.size() > 0) {
+      const auto k = static_cast<std::size_t>(std::max_element(radii.value.begin(), radii.value.end()) -
+                                              radii.value.begin());
+      t_farthest = radii.time[k];
+      a["front_farthest"] = radii.value[k];
+      a["front_farthest_time"] = t_farthest;
+    }
     try {
       analysis::FrontFitOptions fo;
       fo.wall_margin_m = cfg_.grid.cell_size_m;
+      fo.t_end_s = t_farthest;
       a["front_speed"] = analysis::front_speed(fronts, geo, fo).slope;
       a["front_fit"] = analysis::to_json(analysis::front_speed(fronts, geo, fo));
     } catch (const InputError& e) {
@@ -961,6 +975,10 @@ nlohmann::json SceneRun<G>::analysis_result() const {
     const auto stop = analysis::flow_stop_time(shear_frames_, geo, 0.0, cfg_.grid.cell_size_m);
     a["flow_stop"] = analysis::to_json(stop);
     a["flow_stop_time"] = stop.time_s ? nlohmann::json(*stop.time_s) : nlohmann::json(nullptr);
+    // The outer half's rotation relative to the bob and its arrest (below 10% of its peak).
+    const auto outer = analysis::outer_rotation_series(shear_frames_, geo);
+    a["outer_rotation"] = analysis::to_json(outer);
+    a["outer_arrest"] = analysis::to_json(analysis::outer_arrest(outer, 0.1));
   }
   if (cfg_.analysis.kind == scene::AnalysisKind::Couette && fluid_ >= 0 && NC == 3) {
     // Torque on a coaxial cylinder of radius r: M(r) = 2 pi r^2 H tau_r_theta (whole cylinder).
