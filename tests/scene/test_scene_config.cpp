@@ -60,6 +60,17 @@ TEST(SceneConfig, SetOverridesByAliasAndFullPath) {
   EXPECT_DOUBLE_EQ(c.regions[0].phi, 0.2);
   EXPECT_DOUBLE_EQ(c.fluid.kappa_Pa, 3e5);
   EXPECT_EQ(c.grid.shape, scene::ShapeKind::Cubic);
+  // A section the file leaves out is created by --set (settling.toml has no [transfer]) ...
+  const auto f = scene::load_scene(kSettling, {"transfer.scheme=flip", "transfer.flip_fraction=1.0"});
+  EXPECT_EQ(f.transfer.scheme, scene::TransferScheme::Flip);
+  EXPECT_DOUBLE_EQ(f.transfer.flip_fraction, 1.0);
+  // ... and a misspelt key inside it is still an error with a suggestion.
+  try {
+    scene::load_scene(kSettling, {"transfer.schme=flip"});
+    ADD_FAILURE() << "misspelt key accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("did you mean 'transfer.scheme'"), std::string::npos) << e.what();
+  }
 }
 
 TEST(SceneConfig, ErrorsNameFileKeyAndRule) {

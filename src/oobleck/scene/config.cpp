@@ -1,5 +1,7 @@
 #include "oobleck/scene/config.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -102,6 +104,17 @@ void apply_override(toml::table& root, const std::string& file, const std::strin
     const std::string& part = parts[i];
     if (auto* tbl = node->as_table()) {
       node = tbl->get(part);
+      // A section the file leaves out (defaults apply) is created, so that --set reaches every
+      // documented key; a name that is not a section stays an error here, a wrong key inside a
+      // created section is caught by the key validation that follows (with a suggestion).
+      constexpr std::array<const char*, 10> kOptionalSections{"coupling", "transfer", "analysis", "physics", "output",
+                                                               "time",     "fluid",    "material", "scene",   "aliases"};
+      const bool known = i > 0 || std::find(kOptionalSections.begin(), kOptionalSections.end(), part) !=
+                                       kOptionalSections.end();
+      if (node == nullptr && known) {
+        tbl->insert(part, toml::table{});
+        node = tbl->get(part);
+      }
     } else if (auto* arr = node->as_array()) {
       char* end = nullptr;
       const long idx = std::strtol(part.c_str(), &end, 10);
