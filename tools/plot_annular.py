@@ -32,7 +32,8 @@ fr = s["front"]
 ax2.plot([t * 1e3 for t in fr["time"]], [r * 1e3 for r in fr["value"]], "b-")
 if s.get("front_speed") is not None:
     fit = s["front_fit"]
-    ts = [t for t in fr["time"]]
+    t_end = s.get("front_farthest_time", float("inf"))  # fitted while the front advances
+    ts = [t for t in fr["time"] if t <= t_end]
     ax2.plot([t * 1e3 for t in ts], [(fit["intercept"] + fit["slope"] * t) * 1e3 for t in ts], "r--",
              label=f"fit: {s['front_speed'] * 1e3:.0f} mm/s (R² {fit['r_squared']:.3f})")
     ax2.legend(fontsize=8)
