@@ -39,8 +39,8 @@ if s.get("front_speed") is not None:
     ax2.legend(fontsize=8)
 ax2.axhline(ro * 1e3, color="k", lw=0.8)
 if "outer_rotation" in s:
-    # The outer half's mean rotation relative to the bob (0 = at rest): its arrest after the band
-    # reaches the outer wall.
+    # The outer half's mean rotation relative to the bob (0 = at rest) and its first fall below
+    # 10% of its peak (outer_arrest).
     o = s["outer_rotation"]
     ax3 = ax2.twinx()
     ax3.plot([t * 1e3 for t in o["time"]], o["value"], "g-", lw=1)

@@ -105,10 +105,10 @@ FlowStop flow_stop_time(const std::vector<ShearFrame>& frames, const AnnularGeom
 /// the outer half holds no node.
 TimeSeries outer_rotation_series(const std::vector<ShearFrame>& frames, const AnnularGeometry& geometry);
 
-/// Arrest of the outer half after the jammed band reaches the outer wall (S1: "all flow stops
-/// when it reaches the outer wall", with the bob's speed prescribed the layer at the bob keeps
-/// shearing): the peak of the outer rotation and its time, and the first later time at which it
-/// has fallen below `fraction` of that peak (nullopt when it never does or the peak is <= 0).
+/// Arrest of the outer half (S1: "all flow stops when the band reaches the outer wall"; with the
+/// bob's speed prescribed the layer at the bob keeps shearing): the peak of the outer rotation
+/// and its time, and the first later time at which it has fallen below `fraction` of that peak
+/// (nullopt when it never does or the peak is <= 0). Whether it stays arrested: `final_value`.
 struct OuterArrest {
   double peak = 0.0;                   ///< max of the outer rotation [-]
   double peak_time_s = 0.0;

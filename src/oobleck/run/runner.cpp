@@ -938,7 +938,7 @@ nlohmann::json SceneRun<G>::analysis_result() const {
     const auto geo = annular_geometry();
     std::vector<double> angles;
     const double max_angle = geo.bob_speed_m_per_s * shear_frames_.back().time_s / geo.bob_radius_m;
-    // The paper's angles, then later ones in longer runs (the arrest after the band reaches the wall).
+    // The paper's angles, then later ones in longer runs (what the band does next).
     for (double th : {0.0, 0.1, 0.2, 0.31, 0.45, 0.6, 0.8, 1.0}) {
       if (th <= max_angle) angles.push_back(th);
     }
@@ -949,10 +949,10 @@ nlohmann::json SceneRun<G>::analysis_result() const {
     a["newtonian_distance"] = dist;
     a["bob_angle_final_rad"] = max_angle;
     const auto fronts = analysis::jammed_front_series(shear_frames_, geo);
-    a["front"] = analysis::to_json(analysis::front_radius_series(fronts));
-    // The front speed is fitted while the front advances: up to its farthest extent (after the
-    // band reaches the outer wall's influence the front criterion recedes, see docs/results.md).
+    // The front speed is fitted while the front advances: up to its farthest extent (after that
+    // the band unjams and the front criterion recedes, see docs/results.md).
     const auto radii = analysis::front_radius_series(fronts);
+    a["front"] = analysis::to_json(radii);
     double t_farthest = INFINITY;
     if (radii.size() > 0) {
       const auto k = static_cast<std::size_t>(std::max_element(radii.value.begin(), radii.value.end()) -
@@ -965,8 +965,9 @@ nlohmann::json SceneRun<G>::analysis_result() const {
       analysis::FrontFitOptions fo;
       fo.wall_margin_m = cfg_.grid.cell_size_m;
       fo.t_end_s = t_farthest;
-      a["front_speed"] = analysis::front_speed(fronts, geo, fo).slope;
-      a["front_fit"] = analysis::to_json(analysis::front_speed(fronts, geo, fo));
+      const analysis::LinearFit fit = analysis::front_speed(fronts, geo, fo);
+      a["front_speed"] = fit.slope;
+      a["front_fit"] = analysis::to_json(fit);
     } catch (const InputError& e) {
       a["front_speed"] = nullptr;
       a["front_fit_note"] = e.what();

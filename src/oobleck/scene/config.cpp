@@ -109,9 +109,8 @@ void apply_override(toml::table& root, const std::string& file, const std::strin
       // created section is caught by the key validation that follows (with a suggestion).
       constexpr std::array<const char*, 10> kOptionalSections{"coupling", "transfer", "analysis", "physics", "output",
                                                                "time",     "fluid",    "material", "scene",   "aliases"};
-      const bool known = i > 0 || std::find(kOptionalSections.begin(), kOptionalSections.end(), part) !=
-                                       kOptionalSections.end();
-      if (node == nullptr && known) {
+      if (node == nullptr && (i > 0 || std::find(kOptionalSections.begin(), kOptionalSections.end(), part) !=
+                                           kOptionalSections.end())) {
         tbl->insert(part, toml::table{});
         node = tbl->get(part);
       }
