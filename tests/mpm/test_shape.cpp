@@ -56,21 +56,30 @@ void check_kernel(const Kernel& kernel, bool periodic) {
     double sw = 0.0;
     Vec<D> sg = Vec<D>::Zero(), sx = Vec<D>::Zero();
     Eigen::Matrix<double, D, D> xg = Eigen::Matrix<double, D, D>::Zero();
-    for (int k = 0; k < K; ++k) {
-      const auto e = p * K + k;
-      EXPECT_GE(c.w[e], -1e-15);
-      sw += c.w[e];
-      sg += c.grad[e];
-      sx += c.w[e] * c.offset[e];
-      xg += c.offset[e] * c.grad[e].transpose();
+    // The hot-loop traversal (for_each_node) and the per-node accessors give the same nodes and
+    // values in the same order.
+    int k = 0;
+    for_each_node<D, Kernel::support>(c.stencil[p], [&](int i, double w, const double* gr, const double* of) {
+      const Vec<D> grad = Eigen::Map<const Vec<D>>(gr), off = Eigen::Map<const Vec<D>>(of);
+      EXPECT_EQ(i, c.node(p, k));
+      EXPECT_EQ(w, c.weight(p, k));
+      EXPECT_EQ(grad, c.gradient(p, k));
+      EXPECT_EQ(off, c.offset(p, k));
+      ++k;
+      EXPECT_GE(w, -1e-15);
+      sw += w;
+      sg += grad;
+      sx += w * off;
+      xg += off * grad.transpose();
       // The cached offset is the node position minus the point position (unwrapped).
-      Vec<D> xi = g.node_position(c.node[e]);
+      Vec<D> xi = g.node_position(i);
       for (int a = 0; a < D; ++a) {
-        double d = xi[a] - x[p][a] - c.offset[e][a];
+        double d = xi[a] - x[p][a] - off[a];
         if (g.periodic[a]) d -= g.length(a) * std::round(d / g.length(a));
         EXPECT_NEAR(d, 0.0, 1e-12);
       }
-    }
+    });
+    EXPECT_EQ(k, K);
     EXPECT_NEAR(sw, 1.0, 1e-13) << "partition of unity at p=" << p;
     EXPECT_NEAR(sg.norm(), 0.0, 1e-11) << "sum of gradients at p=" << p;
     EXPECT_NEAR(sx.norm(), 0.0, 1e-13) << "linear reproduction at p=" << p;
@@ -98,11 +107,11 @@ void check_gradient_by_finite_differences(const Kernel& kernel) {
       compute_shape_cache(g, kernel, std::vector<Vec<D>>{xp}, cp);
       compute_shape_cache(g, kernel, std::vector<Vec<D>>{xm}, cm);
       std::map<int, double> wp, wm;
-      for (int k = 0; k < cp.K; ++k) wp[cp.node[k]] += cp.w[k];
-      for (int k = 0; k < cm.K; ++k) wm[cm.node[k]] += cm.w[k];
+      for (int k = 0; k < cp.K; ++k) wp[cp.node(0, k)] += cp.weight(0, k);
+      for (int k = 0; k < cm.K; ++k) wm[cm.node(0, k)] += cm.weight(0, k);
       for (int k = 0; k < c0.K; ++k) {
-        const double fd = (wp[c0.node[k]] - wm[c0.node[k]]) / (2 * eps);
-        EXPECT_NEAR(c0.grad[k][a], fd, 1e-5 / g.h_m);
+        const double fd = (wp[c0.node(0, k)] - wm[c0.node(0, k)]) / (2 * eps);
+        EXPECT_NEAR(c0.gradient(0, k)[a], fd, 1e-5 / g.h_m);
       }
     }
   }
@@ -148,14 +157,14 @@ TEST(Shape, ClosedFormValuesAndApicInertia) {
   const Grid<1> g(Vec<1>(0.0), 0.5, {8});
   ShapeCache<1> q, cu;
   compute_shape_cache(g, QuadraticBSplineKernel{}, std::vector<Vec<1>>{Vec<1>(1.0), Vec<1>(1.37)}, q);
-  EXPECT_NEAR(q.w[0], 0.125, 1e-15);
-  EXPECT_NEAR(q.w[1], 0.75, 1e-15);
-  EXPECT_NEAR(q.w[2], 0.125, 1e-15);
+  EXPECT_NEAR(q.weight(0, 0), 0.125, 1e-15);
+  EXPECT_NEAR(q.weight(0, 1), 0.75, 1e-15);
+  EXPECT_NEAR(q.weight(0, 2), 0.125, 1e-15);
   compute_shape_cache(g, CubicBSplineKernel{}, std::vector<Vec<1>>{Vec<1>(1.0), Vec<1>(1.37)}, cu);
-  EXPECT_NEAR(cu.w[0], 1.0 / 6.0, 1e-15);
-  EXPECT_NEAR(cu.w[1], 2.0 / 3.0, 1e-15);
-  EXPECT_NEAR(cu.w[2], 1.0 / 6.0, 1e-15);
-  EXPECT_NEAR(cu.w[3], 0.0, 1e-15);
+  EXPECT_NEAR(cu.weight(0, 0), 1.0 / 6.0, 1e-15);
+  EXPECT_NEAR(cu.weight(0, 1), 2.0 / 3.0, 1e-15);
+  EXPECT_NEAR(cu.weight(0, 2), 1.0 / 6.0, 1e-15);
+  EXPECT_NEAR(cu.weight(0, 3), 0.0, 1e-15);
   for (int p = 0; p < 2; ++p) {
     EXPECT_NEAR(1.0 / q.inv_D[p][0], 0.25 * 0.25, 1e-15);
     EXPECT_NEAR(1.0 / cu.inv_D[p][0], 0.25 / 3.0, 1e-15);

@@ -214,15 +214,14 @@ void scatter_mass_gradient_and_volume(const Body<G>& body, const ShapeCache<G::d
   if (grad)
     for (auto& g : *grad) g.setZero();
   std::fill(volume.begin(), volume.end(), 0.0);
+  constexpr int D = G::dim, S = support_of<D>(K);
   const std::int64_t np = body.size();
   for (std::int64_t p = 0; p < np; ++p) {
     const double m = body.mass_kg[p], V = body.volume_m3[p];
-    const std::int64_t o = p * K;
-    for (int k = 0; k < K; ++k) {
-      const int i = cache.node[o + k];
-      if (grad) (*grad)[i] += m * cache.grad[o + k];
-      volume[i] += cache.w[o + k] * V;
-    }
+    for_each_node<D, S>(cache.stencil[p], [&](int i, double w, const double* g, const double*) {
+      if (grad) (*grad)[i] += m * Eigen::Map<const Vec<D>>(g);
+      volume[i] += w * V;
+    });
   }
 }
 
@@ -234,15 +233,16 @@ void scatter_mass_gradient_and_volume(const Body<G>& body, const ShapeCache<G::d
 template <class G, int K>
 void scatter_mass_gradient_near(const Body<G>& body, const ShapeCache<G::dim>& cache, const Grid<G::dim>& grid,
                                 const Vec<G::dim>& centre, const Vec<G::dim>& half, std::vector<Vec<G::dim>>& grad) {
-  constexpr int D = G::dim;
+  constexpr int D = G::dim, S = support_of<D>(K);
   for (auto& g : grad) g.setZero();
   const std::int64_t np = body.size();
   for (std::int64_t p = 0; p < np; ++p) {
     const Vec<D> d = periodic_difference<D>(grid, body.x_m[p], centre);
     if ((d.cwiseAbs().array() > half.array()).any()) continue;
     const double m = body.mass_kg[p];
-    const std::int64_t o = p * K;
-    for (int k = 0; k < K; ++k) grad[cache.node[o + k]] += m * cache.grad[o + k];
+    for_each_node<D, S>(cache.stencil[p], [&](int i, double, const double* g, const double*) {
+      grad[i] += m * Eigen::Map<const Vec<D>>(g);
+    });
   }
 }
 

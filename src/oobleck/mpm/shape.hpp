@@ -9,6 +9,7 @@
 // (∑N = 1, ∑∇N = 0, ∑N x_i = x_p), which the tests check near walls and periodic seams too.
 #include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "oobleck/mpm/grid.hpp"
@@ -103,128 +104,208 @@ struct UGimpKernel {
   }
 };
 
-/// Per-point cache of the tensor-product shape functions for one body: for point p and local node
-/// k < K = support^D, entry p*K + k holds the flat node index, N_ip, ∇N_ip [1/m] and x_i − x_p [m].
-/// `inv_D` is the diagonal of APIC's inverse inertia D_p⁻¹ [1/m²] (unused for linear weights).
-/// Buffers grow only when the number of points or K grows (no allocation in a steady step).
+/// Largest support (nodes per axis) of any kernel.
+inline constexpr int kMaxSupport = 4;
+
+/// The 1D factors of one point's shape functions: for axis a and its support node j < S, the
+/// storage index times the axis stride of node base + j (periodic seams wrapped), N, dN/dx [1/m]
+/// and x_i − x_p [m]. The D-dimensional values are tensor products formed on the fly
+/// (for_each_node): per point this stores 4 D S numbers instead of S^D nodes × (2 + 2D) numbers,
+/// so the shape pass writes, and P2G/G2P read, a fraction of the bytes.
+template <int D>
+struct Stencil {
+  int index[D][kMaxSupport];
+  double w[D][kMaxSupport];
+  double dw[D][kMaxSupport];
+  double off[D][kMaxSupport];
+};
+
+/// Support per axis S of a kernel with K = S^D nodes per point.
+template <int D>
+constexpr int support_of(int K) {
+  for (int s = 1; s <= kMaxSupport; ++s) {
+    int k = 1;
+    for (int a = 0; a < D; ++a) k *= s;
+    if (k == K) return s;
+  }
+  return 0;
+}
+
+/// Visit the S^D support nodes of a stencil with f(i, N_ip, ∇N_ip, x_i − x_p): flat node index,
+/// weight, gradient [1/m] (double[D]) and offset [m] (double[D]). Local node k enumerates
+/// (j_0, …, j_{D−1}) with the last axis fastest (the scatter order, hence the round-off, is fixed).
+/// Products are formed as ((N_0 N_1) N_2) and ∂_a N = (N'_a ∏_{b≠a} N_b in increasing b).
+template <int D, int S, class F>
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void for_each_node(const Stencil<D>& s, F&& f) {
+  static_assert(D >= 1 && D <= 3 && S >= 1 && S <= kMaxSupport);
+  if constexpr (D == 1) {
+    for (int j0 = 0; j0 < S; ++j0) {
+      const double g[1] = {s.dw[0][j0]}, o[1] = {s.off[0][j0]};
+      f(s.index[0][j0], s.w[0][j0], g, o);
+    }
+  } else if constexpr (D == 2) {
+    for (int j0 = 0; j0 < S; ++j0) {
+      for (int j1 = 0; j1 < S; ++j1) {
+        const double g[2] = {s.dw[0][j0] * s.w[1][j1], s.w[0][j0] * s.dw[1][j1]};
+        const double o[2] = {s.off[0][j0], s.off[1][j1]};
+        f(s.index[0][j0] + s.index[1][j1], s.w[0][j0] * s.w[1][j1], g, o);
+      }
+    }
+  } else {
+    for (int j0 = 0; j0 < S; ++j0) {
+      for (int j1 = 0; j1 < S; ++j1) {
+        const double w01 = s.w[0][j0] * s.w[1][j1];
+        const double g0 = s.dw[0][j0] * s.w[1][j1], g1 = s.dw[1][j1] * s.w[0][j0];
+        const int i01 = s.index[0][j0] + s.index[1][j1];
+        for (int j2 = 0; j2 < S; ++j2) {
+          const double g[3] = {g0 * s.w[2][j2], g1 * s.w[2][j2], (s.dw[2][j2] * s.w[0][j0]) * s.w[1][j1]};
+          const double o[3] = {s.off[0][j0], s.off[1][j1], s.off[2][j2]};
+          f(i01 + s.index[2][j2], w01 * s.w[2][j2], g, o);
+        }
+      }
+    }
+  }
+}
+
+/// Per-point cache of the shape functions of one body: one Stencil per point (computed once per
+/// step, model.md §6 step 1) and `inv_D`, the diagonal of APIC's inverse inertia D_p⁻¹ [1/m²]
+/// (unused for linear weights). S = support per axis, K = S^D nodes per point. Buffers grow only
+/// when the number of points grows (no allocation in a steady step). The per-node accessors below
+/// are for tests and cold code; hot loops use for_each_node.
 template <int D>
 struct ShapeCache {
+  int S = 0;
   int K = 0;
   bool apic_by_gradient = false;
   std::int64_t points = 0;
-  std::vector<int> node;
-  std::vector<double> w;
-  std::vector<Vec<D>> grad;
-  std::vector<Vec<D>> offset;
+  std::vector<Stencil<D>> stencil;
   std::vector<Vec<D>> inv_D;
 
-  void reserve(std::int64_t np, int k) {
-    K = k;
+  void reserve(std::int64_t np, int support) {
+    S = support;
+    K = 1;
+    for (int a = 0; a < D; ++a) K *= support;
     points = np;
-    const auto n = static_cast<std::size_t>(np * k);
-    if (node.size() < n) {
-      node.resize(n);
-      w.resize(n);
-      grad.resize(n);
-      offset.resize(n);
+    if (stencil.size() < static_cast<std::size_t>(np)) {
+      stencil.resize(static_cast<std::size_t>(np));
+      inv_D.resize(static_cast<std::size_t>(np));
     }
-    if (inv_D.size() < static_cast<std::size_t>(np)) inv_D.resize(static_cast<std::size_t>(np));
+  }
+  /// Flat node index, N_ip, ∇N_ip [1/m] and x_i − x_p [m] of local node k < K of point p.
+  int node(std::int64_t p, int k) const {
+    int i = 0;
+    for_local(k, [&](int a, int j) { i += stencil[p].index[a][j]; });
+    return i;
+  }
+  double weight(std::int64_t p, int k) const { return value(p, k).first; }
+  Vec<D> gradient(std::int64_t p, int k) const { return value(p, k).second; }
+  Vec<D> offset(std::int64_t p, int k) const {
+    Vec<D> o;
+    for_local(k, [&](int a, int j) { o[a] = stencil[p].off[a][j]; });
+    return o;
+  }
+
+ private:
+  template <class F>
+  void for_local(int k, F&& f) const {
+    int j[D];
+    for (int a = D - 1; a >= 0; --a) {
+      j[a] = k % S;
+      k /= S;
+    }
+    for (int a = 0; a < D; ++a) f(a, j[a]);
+  }
+  std::pair<double, Vec<D>> value(std::int64_t p, int k) const {
+    int j[D];
+    for_local(k, [&](int a, int ja) { j[a] = ja; });
+    const Stencil<D>& s = stencil[p];
+    double w = 1.0;
+    Vec<D> g;
+    for (int a = 0; a < D; ++a) {
+      w *= s.w[a][j[a]];
+      double ga = s.dw[a][j[a]];
+      for (int b = 0; b < D; ++b)
+        if (b != a) ga *= s.w[b][j[b]];
+      g[a] = ga;
+    }
+    return {w, g};
   }
 };
+
+/// What make_stencil needs of the grid, gathered once per pass.
+template <int D>
+struct StencilGrid {
+  double origin[D], h, inv_h;
+  int stride[D], nodes[D];
+  bool periodic[D];
+  explicit StencilGrid(const Grid<D>& grid) : h(grid.h_m), inv_h(1.0 / grid.h_m) {
+    for (int a = 0; a < D; ++a) {
+      origin[a] = grid.origin_m[a];
+      stride[a] = grid.stride(a);
+      nodes[a] = grid.nodes(a);
+      periodic[a] = grid.periodic[a];
+    }
+  }
+};
+
+/// The stencil of a point at x and the diagonal of APIC's D_p⁻¹ [1/m²]. Returns false when the
+/// support leaves the stored nodes (non-periodic axes; those indices are set to 0).
+template <int D, class Kernel>
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline bool make_stencil(const Grid<D>& grid, const StencilGrid<D>& sg, const Kernel& kernel, const Vec<D>& x,
+                         Stencil<D>& s, double* inv_D) {
+  constexpr int S = Kernel::support;
+  bool ok = true;
+  for (int a = 0; a < D; ++a) {
+    const double xi = (x[a] - sg.origin[a]) * sg.inv_h;
+    int base = 0;
+    kernel(xi, base, s.w[a], s.dw[a]);
+    double m2 = 0.0;
+    for (int j = 0; j < S; ++j) {
+      s.dw[a][j] *= sg.inv_h;
+      s.off[a][j] = (base + j - xi) * sg.h;
+      m2 += s.w[a][j] * s.off[a][j] * s.off[a][j];
+    }
+    // Storage indices of base … base + S − 1 (= grid.storage_index, one modulo per axis).
+    if (sg.periodic[a]) {
+      // base is within one cell of [0, cells) for a wrapped point: no integer division then.
+      int st = base < 0 ? base + sg.nodes[a] : base;
+      if (st < 0 || st >= sg.nodes[a]) st = grid.storage_index(a, base);
+      for (int j = 0; j < S; ++j, ++st) {
+        if (st >= sg.nodes[a]) st -= sg.nodes[a];
+        s.index[a][j] = st * sg.stride[a];
+      }
+    } else {
+      for (int j = 0; j < S; ++j) {
+        const int st = base + j + Grid<D>::kGhost;
+        const bool in = st >= 0 && st < sg.nodes[a];
+        ok = ok && in;
+        s.index[a][j] = in ? st * sg.stride[a] : 0;
+      }
+    }
+    if (inv_D) inv_D[a] = m2 > 0.0 ? 1.0 / m2 : 0.0;
+  }
+  return ok;
+}
 
 /// Fill the cache for all points at positions x (OpenMP over points). Returns the number of
 /// points whose support leaves the stored nodes (0 when all is well; the caller reports them).
 template <int D, class Kernel>
 std::int64_t compute_shape_cache(const Grid<D>& grid, const Kernel& kernel, const std::vector<Vec<D>>& x,
                                  ShapeCache<D>& cache) {
-  constexpr int S = Kernel::support;
-  int K = 1;
-  for (int a = 0; a < D; ++a) K *= S;
   const auto np = static_cast<std::int64_t>(x.size());
-  cache.reserve(np, K);
+  cache.reserve(np, Kernel::support);
   cache.apic_by_gradient = Kernel::apic_by_gradient;
-  const double h = grid.h_m, inv_h = 1.0 / h;
-  int stride[D], nodes[D];
-  bool periodic[D];
-  for (int a = 0; a < D; ++a) {
-    stride[a] = grid.stride(a);
-    nodes[a] = grid.nodes(a);
-    periodic[a] = grid.periodic[a];
-  }
+  const StencilGrid<D> sg(grid);
   std::int64_t bad = 0;
 #pragma omp parallel for schedule(static) reduction(+ : bad)
-  for (std::int64_t p = 0; p < np; ++p) {
-    double w1[D][S], dw1[D][S], off1[D][S];
-    int idx1[D][S];
-    bool ok = true;
-    for (int a = 0; a < D; ++a) {
-      const double xi = (x[p][a] - grid.origin_m[a]) * inv_h;
-      int base = 0;
-      kernel(xi, base, w1[a], dw1[a]);
-      double m2 = 0.0;
-      for (int j = 0; j < S; ++j) {
-        dw1[a][j] *= inv_h;
-        off1[a][j] = (base + j - xi) * h;
-        m2 += w1[a][j] * off1[a][j] * off1[a][j];
-      }
-      // Storage indices of base … base + S − 1 (= grid.storage_index, one modulo per axis).
-      if (periodic[a]) {
-        int st = grid.storage_index(a, base);
-        for (int j = 0; j < S; ++j, ++st) {
-          if (st >= nodes[a]) st -= nodes[a];
-          idx1[a][j] = st * stride[a];
-        }
-      } else {
-        for (int j = 0; j < S; ++j) {
-          const int st = base + j + Grid<D>::kGhost;
-          const bool in = st >= 0 && st < nodes[a];
-          ok = ok && in;
-          idx1[a][j] = in ? st * stride[a] : 0;
-        }
-      }
-      cache.inv_D[p][a] = m2 > 0.0 ? 1.0 / m2 : 0.0;
-    }
-    if (!ok) ++bad;
-    // Tensor product; local node k enumerates (j_0, …, j_{D−1}) with the last axis fastest.
-    const std::int64_t o = p * K;
-    if constexpr (D == 2) {
-      int k = 0;
-      for (int j0 = 0; j0 < S; ++j0) {
-        for (int j1 = 0; j1 < S; ++j1, ++k) {
-          cache.node[o + k] = idx1[0][j0] + idx1[1][j1];
-          cache.w[o + k] = w1[0][j0] * w1[1][j1];
-          cache.grad[o + k] = Vec<D>(dw1[0][j0] * w1[1][j1], w1[0][j0] * dw1[1][j1]);
-          cache.offset[o + k] = Vec<D>(off1[0][j0], off1[1][j1]);
-        }
-      }
-    } else {
-      for (int k = 0; k < K; ++k) {
-        int rem = k, flat = 0;
-        double wk = 1.0;
-        int j[D];
-        for (int a = D - 1; a >= 0; --a) {
-          j[a] = rem % S;
-          rem /= S;
-        }
-        Vec<D> g, off;
-        for (int a = 0; a < D; ++a) {
-          flat += idx1[a][j[a]];
-          wk *= w1[a][j[a]];
-          off[a] = off1[a][j[a]];
-        }
-        for (int a = 0; a < D; ++a) {
-          double ga = dw1[a][j[a]];
-          for (int b = 0; b < D; ++b)
-            if (b != a) ga *= w1[b][j[b]];
-          g[a] = ga;
-        }
-        cache.node[o + k] = flat;
-        cache.w[o + k] = wk;
-        cache.grad[o + k] = g;
-        cache.offset[o + k] = off;
-      }
-    }
-  }
+  for (std::int64_t p = 0; p < np; ++p)
+    if (!make_stencil(grid, sg, kernel, x[p], cache.stencil[p], cache.inv_D[p].data())) ++bad;
   return bad;
 }
 

@@ -74,11 +74,7 @@ using V2 = Eigen::Matrix<double, 2, 1>;
 template <class G, int K, bool Apic, bool Split>
 inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim>& cache, std::int64_t p,
                                     double* m, double* mv, double* f, double* fp, double* vol) {
-  constexpr int D = G::dim, NC = G::ncomp;
-  const int* const node = cache.node.data();
-  const double* const wt = cache.w.data();
-  const double* const grad = cache.grad.data()->data();
-  const double* const offset = cache.offset.data()->data();
+  constexpr int D = G::dim, NC = G::ncomp, S = support_of<D>(K);
   {
     const double mp = body.mass_kg[p], Vp = body.volume_m3[p];
     const Vec<NC> vp = body.v_m_s[p];
@@ -120,18 +116,13 @@ inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim
     }
     const V2 v2(v[0], v[1]), fpt2(fpt[0], fpt[1]);
     const double v3 = v[NC - 1], fpt3 = fpt[NC - 1];
-    const std::int64_t o = p * K;
-    for (int k = 0; k < K; ++k) {
-      const int i = node[o + k];
-      const double w = wt[o + k];
-      const double* g = grad + (o + k) * D;
+    for_each_node<D, S>(cache.stencil[p], [&](int i, double w, const double* g, const double* off) {
       const double wm = w * mp;
       double* mvi = mv + static_cast<std::int64_t>(i) * NC;
       double* fi = f + static_cast<std::int64_t>(i) * NC;
       m[i] += wm;
       Eigen::Map<V2> mvi2(mvi), fi2(fi);
       if constexpr (Apic) {
-        const double* off = offset + (o + k) * D;
         V2 cx = Cp2[0] * off[0];
         for (int a = 1; a < D; ++a) cx += Cp2[a] * off[a];
         mvi2 += wm * (v2 + cx);
@@ -141,6 +132,7 @@ inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim
           mvi[2] += wm * (v3 + cx3);
         }
       } else {
+        (void)off;
         mvi2 += wm * v2;
         if constexpr (NC == 3) mvi[2] += wm * v3;
       }
@@ -163,7 +155,7 @@ inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim
           for (int c = 0; c < NC; ++c) fpi[c] += w * fppt[c];
         vol[i] += w * Vp;
       }
-    }
+    });
   }
 }
 
@@ -268,12 +260,8 @@ template <class G, int K, bool Apic, bool ByGrad, bool Mixture>
 void grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& cache, const GridField<G>& field,
                               const Grid<G::dim>& grid, double alpha, double dt_s, const double* porosity,
                               const Vec<G::ncomp>* mixture_flux) {
-  constexpr int D = G::dim, NC = G::ncomp;
+  constexpr int D = G::dim, NC = G::ncomp, S = support_of<D>(K);
   const std::int64_t np = body.size();
-  const int* const node = cache.node.data();
-  const double* const wt = cache.w.data();
-  const double* const grad = cache.grad.data()->data();
-  const double* const offset = cache.offset.data()->data();
   const double* const inv_D = cache.inv_D.data()->data();
   const double* const vel = field.velocity.data()->data();
   const double* const vel_old = field.velocity_old.data()->data();
@@ -295,11 +283,7 @@ void grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& cache, co
       B3[a] = 0.0;
     }
     double n_p = 0.0, div_q = 0.0;
-    const std::int64_t o = p * K;
-    for (int k = 0; k < K; ++k) {
-      const int i = node[o + k];
-      const double w = wt[o + k];
-      const double* g = grad + (o + k) * D;
+    for_each_node<D, S>(cache.stencil[p], [&](int i, double w, const double* g, const double* off) {
       const double* vi = vel + static_cast<std::int64_t>(i) * NC;
       const V2 vi2 = Eigen::Map<const V2>(vi);
       const double vi3 = NC == 3 ? vi[NC - 1] : 0.0;
@@ -322,7 +306,6 @@ void grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& cache, co
       }
       if constexpr (Apic) {
         if constexpr (!ByGrad) {
-          const double* off = offset + (o + k) * D;
           const V2 wv2 = w * vi2;
           const double wv3 = w * vi3;
           for (int a = 0; a < D; ++a) {
@@ -335,7 +318,8 @@ void grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& cache, co
         dv2 += w * (vi2 - Eigen::Map<const V2>(vo));
         if constexpr (NC == 3) dv3 += w * (vi3 - vo[2]);
       }
-    }
+      (void)off;
+    });
     double v_pic[NC], dv[NC], q_p[NC], grad_v[D][NC], B[D][NC];  // column-major like Mat<NC, D>
     for (int c = 0; c < 2; ++c) {
       v_pic[c] = vp2[c];
