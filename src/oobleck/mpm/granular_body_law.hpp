@@ -40,7 +40,11 @@ class GranularBodyLaw final : public StressLaw<G> {
   void update_stress(Body<G>& body, double dt_s) override {
     const std::int64_t np = body.size();
     std::int64_t first_bad = std::numeric_limits<std::int64_t>::max();
-#pragma omp parallel for schedule(static) reduction(min : first_bad)
+    // Dynamic chunks: the cost per point ranges from a closed form to tens of Newton steps and
+    // an implicit structure solve, and it is clustered in space (points are stored by region), so
+    // a static split left one thread waiting (rod impact: 1.3x faster stress pass on 2 threads).
+    // Each point is independent: the results do not depend on the schedule.
+#pragma omp parallel for schedule(dynamic, 256) reduction(min : first_bad)
     for (std::int64_t q = 0; q < np; ++q) {
       // Element by element (same values as 0.5 (L +- L^T) and plain copies): GCC compiled the Eigen
       // forms into an out-of-line assignment loop and rep-movs block copies.
