@@ -59,7 +59,7 @@ void check_kernel(const Kernel& kernel, bool periodic) {
     // The hot-loop traversal (for_each_node) and the per-node accessors give the same nodes and
     // values in the same order.
     int k = 0;
-    for_each_node<D, Kernel::support>(c.stencil[p], [&](int i, double w, const double* gr, const double* of) {
+    for_each_node<D, Kernel::support>(c.template stencil<Kernel::support>(static_cast<std::int64_t>(p)), [&](int i, double w, const double* gr, const double* of) {
       const Vec<D> grad = Eigen::Map<const Vec<D>>(gr), off = Eigen::Map<const Vec<D>>(of);
       EXPECT_EQ(i, c.node(p, k));
       EXPECT_EQ(w, c.weight(p, k));

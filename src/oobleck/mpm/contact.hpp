@@ -218,7 +218,7 @@ void scatter_mass_gradient_and_volume(const Body<G>& body, const ShapeCache<G::d
   const std::int64_t np = body.size();
   for (std::int64_t p = 0; p < np; ++p) {
     const double m = body.mass_kg[p], V = body.volume_m3[p];
-    for_each_node<D, S>(cache.stencil[p], [&](int i, double w, const double* g, const double*) {
+    for_each_node<D, S>(cache.template stencil<S>(p), [&](int i, double w, const double* g, const double*) {
       if (grad) (*grad)[i] += m * Eigen::Map<const Vec<D>>(g);
       volume[i] += w * V;
     });
@@ -240,7 +240,7 @@ void scatter_mass_gradient_near(const Body<G>& body, const ShapeCache<G::dim>& c
     const Vec<D> d = periodic_difference<D>(grid, body.x_m[p], centre);
     if ((d.cwiseAbs().array() > half.array()).any()) continue;
     const double m = body.mass_kg[p];
-    for_each_node<D, S>(cache.stencil[p], [&](int i, double, const double* g, const double*) {
+    for_each_node<D, S>(cache.template stencil<S>(p), [&](int i, double, const double* g, const double*) {
       grad[i] += m * Eigen::Map<const Vec<D>>(g);
     });
   }

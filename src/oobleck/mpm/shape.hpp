@@ -112,12 +112,12 @@ inline constexpr int kMaxSupport = 4;
 /// and x_i − x_p [m]. The D-dimensional values are tensor products formed on the fly
 /// (for_each_node): per point this stores 4 D S numbers instead of S^D nodes × (2 + 2D) numbers,
 /// so the shape pass writes, and P2G/G2P read, a fraction of the bytes.
-template <int D>
+template <int D, int S>
 struct Stencil {
-  int index[D][kMaxSupport];
-  double w[D][kMaxSupport];
-  double dw[D][kMaxSupport];
-  double off[D][kMaxSupport];
+  int index[D][S];
+  double w[D][S];
+  double dw[D][S];
+  double off[D][S];
 };
 
 /// Support per axis S of a kernel with K = S^D nodes per point.
@@ -139,7 +139,7 @@ template <int D, int S, class F>
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void for_each_node(const Stencil<D>& s, F&& f) {
+inline void for_each_node(const Stencil<D, S>& s, F&& f) {
   static_assert(D >= 1 && D <= 3 && S >= 1 && S <= kMaxSupport);
   if constexpr (D == 1) {
     for (int j0 = 0; j0 < S; ++j0) {
@@ -171,17 +171,17 @@ inline void for_each_node(const Stencil<D>& s, F&& f) {
 }
 
 /// Per-point cache of the shape functions of one body: one Stencil per point (computed once per
-/// step, model.md §6 step 1) and `inv_D`, the diagonal of APIC's inverse inertia D_p⁻¹ [1/m²]
-/// (unused for linear weights). S = support per axis, K = S^D nodes per point. Buffers grow only
-/// when the number of points grows (no allocation in a steady step). The per-node accessors below
-/// are for tests and cold code; hot loops use for_each_node.
+/// step, model.md §6 step 1), sized for the kernel's support S (one of the three arrays is used),
+/// and `inv_D`, the diagonal of APIC's inverse inertia D_p⁻¹ [1/m²] (unused for linear weights).
+/// K = S^D nodes per point. Buffers grow only when the number of points grows (no allocation in a
+/// steady step). The per-node accessors are for tests and cold code; hot loops use
+/// for_each_node(cache.stencil<S>(p), …).
 template <int D>
 struct ShapeCache {
   int S = 0;
   int K = 0;
   bool apic_by_gradient = false;
   std::int64_t points = 0;
-  std::vector<Stencil<D>> stencil;
   std::vector<Vec<D>> inv_D;
 
   void reserve(std::int64_t np, int support) {
@@ -189,49 +189,85 @@ struct ShapeCache {
     K = 1;
     for (int a = 0; a < D; ++a) K *= support;
     points = np;
-    if (stencil.size() < static_cast<std::size_t>(np)) {
-      stencil.resize(static_cast<std::size_t>(np));
-      inv_D.resize(static_cast<std::size_t>(np));
-    }
+    const auto n = static_cast<std::size_t>(np);
+    if (inv_D.size() < n) inv_D.resize(n);
+    with_support([&](auto& v) {
+      if (v.size() < n) v.resize(n);
+    });
   }
+  template <int Sk>
+  const Stencil<D, Sk>& stencil(std::int64_t p) const {
+    return stencils<Sk>()[static_cast<std::size_t>(p)];
+  }
+  template <int Sk>
+  Stencil<D, Sk>& stencil(std::int64_t p) {
+    return const_cast<Stencil<D, Sk>&>(std::as_const(*this).template stencil<Sk>(p));
+  }
+
   /// Flat node index, N_ip, ∇N_ip [1/m] and x_i − x_p [m] of local node k < K of point p.
   int node(std::int64_t p, int k) const {
-    int i = 0;
-    for_local(k, [&](int a, int j) { i += stencil[p].index[a][j]; });
-    return i;
+    return visit(p, k, [](const auto& s, const int* j) {
+      int i = 0;
+      for (int a = 0; a < D; ++a) i += s.index[a][j[a]];
+      return i;
+    });
   }
-  double weight(std::int64_t p, int k) const { return value(p, k).first; }
-  Vec<D> gradient(std::int64_t p, int k) const { return value(p, k).second; }
+  double weight(std::int64_t p, int k) const {
+    return visit(p, k, [](const auto& s, const int* j) {
+      double w = 1.0;
+      for (int a = 0; a < D; ++a) w *= s.w[a][j[a]];
+      return w;
+    });
+  }
+  Vec<D> gradient(std::int64_t p, int k) const {
+    return visit(p, k, [](const auto& s, const int* j) {
+      Vec<D> g;
+      for (int a = 0; a < D; ++a) {
+        double ga = s.dw[a][j[a]];
+        for (int b = 0; b < D; ++b)
+          if (b != a) ga *= s.w[b][j[b]];
+        g[a] = ga;
+      }
+      return g;
+    });
+  }
   Vec<D> offset(std::int64_t p, int k) const {
-    Vec<D> o;
-    for_local(k, [&](int a, int j) { o[a] = stencil[p].off[a][j]; });
-    return o;
+    return visit(p, k, [](const auto& s, const int* j) {
+      Vec<D> o;
+      for (int a = 0; a < D; ++a) o[a] = s.off[a][j[a]];
+      return o;
+    });
   }
 
  private:
+  std::vector<Stencil<D, 2>> stencil2_;
+  std::vector<Stencil<D, 3>> stencil3_;
+  std::vector<Stencil<D, 4>> stencil4_;
+
+  template <int Sk>
+  const std::vector<Stencil<D, Sk>>& stencils() const {
+    static_assert(Sk >= 2 && Sk <= kMaxSupport);
+    if constexpr (Sk == 2) return stencil2_;
+    else if constexpr (Sk == 3) return stencil3_;
+    else return stencil4_;
+  }
   template <class F>
-  void for_local(int k, F&& f) const {
+  void with_support(F&& f) {
+    if (S == 2) f(stencil2_);
+    else if (S == 3) f(stencil3_);
+    else f(stencil4_);
+  }
+  /// f(stencil of p, per-axis indices of local node k), the last axis fastest.
+  template <class F>
+  auto visit(std::int64_t p, int k, F&& f) const {
     int j[D];
     for (int a = D - 1; a >= 0; --a) {
       j[a] = k % S;
       k /= S;
     }
-    for (int a = 0; a < D; ++a) f(a, j[a]);
-  }
-  std::pair<double, Vec<D>> value(std::int64_t p, int k) const {
-    int j[D];
-    for_local(k, [&](int a, int ja) { j[a] = ja; });
-    const Stencil<D>& s = stencil[p];
-    double w = 1.0;
-    Vec<D> g;
-    for (int a = 0; a < D; ++a) {
-      w *= s.w[a][j[a]];
-      double ga = s.dw[a][j[a]];
-      for (int b = 0; b < D; ++b)
-        if (b != a) ga *= s.w[b][j[b]];
-      g[a] = ga;
-    }
-    return {w, g};
+    if (S == 2) return f(stencil<2>(p), j);
+    if (S == 3) return f(stencil<3>(p), j);
+    return f(stencil<4>(p), j);
   }
 };
 
@@ -258,7 +294,7 @@ template <int D, class Kernel>
 [[gnu::always_inline]]
 #endif
 inline bool make_stencil(const Grid<D>& grid, const StencilGrid<D>& sg, const Kernel& kernel, const Vec<D>& x,
-                         Stencil<D>& s, double* inv_D) {
+                         Stencil<D, Kernel::support>& s, double* inv_D) {
   constexpr int S = Kernel::support;
   bool ok = true;
   for (int a = 0; a < D; ++a) {
@@ -305,7 +341,7 @@ std::int64_t compute_shape_cache(const Grid<D>& grid, const Kernel& kernel, cons
   std::int64_t bad = 0;
 #pragma omp parallel for schedule(static) reduction(+ : bad)
   for (std::int64_t p = 0; p < np; ++p)
-    if (!make_stencil(grid, sg, kernel, x[p], cache.stencil[p], cache.inv_D[p].data())) ++bad;
+    if (!make_stencil(grid, sg, kernel, x[p], cache.template stencil<Kernel::support>(p), cache.inv_D[p].data())) ++bad;
   return bad;
 }
 

@@ -116,7 +116,7 @@ inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim
     }
     const V2 v2(v[0], v[1]), fpt2(fpt[0], fpt[1]);
     const double v3 = v[NC - 1], fpt3 = fpt[NC - 1];
-    for_each_node<D, S>(cache.stencil[p], [&](int i, double w, const double* g, const double* off) {
+    for_each_node<D, S>(cache.template stencil<S>(p), [&](int i, double w, const double* g, const double* off) {
       const double wm = w * mp;
       double* mvi = mv + static_cast<std::int64_t>(i) * NC;
       double* fi = f + static_cast<std::int64_t>(i) * NC;
@@ -283,7 +283,7 @@ void grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& cache, co
       B3[a] = 0.0;
     }
     double n_p = 0.0, div_q = 0.0;
-    for_each_node<D, S>(cache.stencil[p], [&](int i, double w, const double* g, const double* off) {
+    for_each_node<D, S>(cache.template stencil<S>(p), [&](int i, double w, const double* g, const double* off) {
       const double* vi = vel + static_cast<std::int64_t>(i) * NC;
       const V2 vi2 = Eigen::Map<const V2>(vi);
       const double vi3 = NC == 3 ? vi[NC - 1] : 0.0;
