@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Paper Fig. 6 from an annular-shear run (scenes/paper/annular_shear.toml): surface v_theta/u_i
 profiles at the bob rotation angles in summary.json beside the Newtonian A r + B/r profile, and
-the jammed-front radius vs time.
+the fronts vs time: the co-rotating band (v_theta/(omega r) = 0.5) and the jammed structure
+(f = f_m/2), with the outer half's rotation.
 
 usage: plot_annular.py RUN_DIR OUT.png
 """
@@ -37,6 +38,13 @@ if s.get("front_speed") is not None:
     ax2.plot([t * 1e3 for t in ts], [(fit["intercept"] + fit["slope"] * t) * 1e3 for t in ts], "r--",
              label=f"fit: {s['front_speed'] * 1e3:.0f} mm/s (R² {fit['r_squared']:.3f})")
     ax2.legend(fontsize=8)
+if "structure_front" in s:
+    sf = s["structure_front"]
+    ax2.plot([t * 1e3 for t in sf["time"]], [r * 1e3 for r in sf["value"]], "m-",
+             label=f"structure f = {s['structure_front_threshold']:.3g} (f_m/2)")
+    if s.get("structure_front_wall_time") is not None:
+        ax2.axvline(s["structure_front_wall_time"] * 1e3, color="m", ls=":", lw=0.8)
+    ax2.legend(fontsize=8)
 ax2.axhline(ro * 1e3, color="k", lw=0.8)
 if "outer_rotation" in s:
     # The outer half's mean rotation relative to the bob (0 = at rest) and its first fall below
@@ -50,6 +58,6 @@ if "outer_rotation" in s:
     if arrest.get("time") is not None:
         ax3.axvline(arrest["time"] * 1e3, color="g", ls=":", lw=0.8)
 ax2.set_xlabel("t [ms]")
-ax2.set_ylabel("jammed front radius [mm] (v_θ/(ω r) = 0.5)")
+ax2.set_ylabel("front radius [mm] (blue: v_θ/(ω r) = 0.5)")
 ax2.set_title(f"{s['scene']}: {p['cells'][0]}×{p['cells'][1]} cells of {p['cell_size'] * 1e3:g} mm", fontsize=9)
 save(fig, out)

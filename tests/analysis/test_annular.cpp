@@ -185,6 +185,38 @@ TEST(AnnularShear, OuterHalfRotationAndItsArrest) {
   EXPECT_THROW(outer_arrest(outer, 1.5), InputError);
 }
 
+TEST(AnnularShear, StructureFrontFollowsTheSpreadOfF) {
+  // f = 0.3 out to r_s, then falling linearly to 0 over 6 mm: f = 0.15 (the threshold) exactly
+  // 3 mm beyond r_s. r_s = r_0 + 0.03 m/s t reaches the wall's last 1 mm margin (f = 0.15 at
+  // r >= 47.5 mm) at t = (47.5 - 3 - 12.5) mm / 0.03 m/s = 1.0667 s.
+  auto frame = [](double t) {
+    ShearFrame fr = band_frame(t, kR0 + 2e-3);
+    fr.f = grid();
+    const double r_s = kR0 + 0.03 * t;
+    for (std::size_t j = 0; j < fr.f.ny; ++j)
+      for (std::size_t i = 0; i < fr.f.nx; ++i)
+        fr.f.at(i, j) = 0.3 * std::clamp(1.0 - (fr.f.x(i) - r_s) / 6e-3, 0.0, 1.0);
+    return fr;
+  };
+  std::vector<ShearFrame> frames;
+  for (int k = 0; k <= 14; ++k) frames.push_back(frame(0.1 * k));
+  const AnnularGeometry g = geometry();
+  const std::vector<ShearFront> fronts = structure_front_series(frames, g, 0.15);
+  for (std::size_t k = 0; k < 11; ++k) {
+    ASSERT_TRUE(fronts[k].found);
+    EXPECT_NEAR(fronts[k].radius_m, kR0 + 3e-3 + 0.03 * frames[k].time_s, 1e-12);
+  }
+  const auto t_wall = front_at_wall_time(fronts, g, 1e-3);
+  ASSERT_TRUE(t_wall.has_value());
+  EXPECT_NEAR(*t_wall, 1.1, 1e-12);  // the first frame at or after 1.0667 s
+  EXPECT_TRUE(fronts.back().at_wall);  // r_s = 54.5 mm: f >= 0.15 everywhere in the gap
+  EXPECT_FALSE(front_at_wall_time(std::vector<ShearFront>(fronts.begin(), fronts.begin() + 10), g, 1e-3).has_value());
+  // The velocity front of the same frames stays where band_frame put it: the two are independent.
+  EXPECT_NEAR(jammed_front(frames[5], g).radius_m, kR0 + 2e-3, 1e-12);
+  EXPECT_THROW(structure_front(band_frame(0.0, 0.02), g, 0.15), InputError);  // no f sampled
+  EXPECT_THROW(front_at_wall_time(fronts, g, -1.0), InputError);
+}
+
 TEST(AnnularShear, RejectsBadInput) {
   std::vector<ShearFrame> frames{band_frame(0.0, 0.02), band_frame(0.0, 0.021)};
   EXPECT_THROW(jammed_front_series(frames, geometry()), InputError);  // equal times

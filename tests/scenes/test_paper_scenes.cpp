@@ -44,17 +44,21 @@ TEST(PaperScenes, AnnularShearFastBobGrowsAJammedCoRotatingBand) {
 }
 
 TEST(PaperScenes, AnnularShearBandIsDraggedOutThenReleased) {
-  // S1 fast bob on a 2 mm grid for 0.1 s (0.67 rad): the band grows and drags the outer half of
-  // the gap along (its mean rotation reaches a good fraction of the bob's); then the band
-  // collapses, the outer half comes almost to rest (below 10% of that peak) and the flow turns
-  // Newtonian-like. Measured at 1 mm: peak 0.36 at 51 ms, below 10% at 66 ms, front farthest at
-  // r = 34.8 mm (docs/results.md; the paper's band reaches the outer wall, ours does not).
+  // S1 fast bob on a 2 mm grid for 0.1 s (0.67 rad): the co-rotating band grows and drags the
+  // outer half of the gap along (its mean rotation reaches a good fraction of the bob's); then the
+  // co-rotation fades, the outer half comes almost to rest (below 10% of that peak) and the
+  // profile turns Newtonian-like. The jammed structure itself never recedes: f >= f_m/2 spreads
+  // monotonically and reaches the outer wall, after the velocity band's farthest extent and
+  // before the arrest. Measured at 1 mm: band farthest at r = 34.8 mm at 48 ms, structure at the
+  // wall at 55 ms, outer half below 10% at 66 ms (docs/results.md).
   clitest::TempDir d;
   const auto s = run_paper_scene("annular_shear.toml", d / "run", {"grid.cell_size=0.002", "duration=0.1"});
   const auto& a = s["outer_arrest"];
-  std::printf("[ measured ] coarse annular: outer rotation peak %.3f at %.3f s, arrest at %s s, front farthest %.4f m\n",
+  std::printf("[ measured ] coarse annular: outer rotation peak %.3f at %.3f s, arrest at %s s, front farthest %.4f m "
+              "at %.3f s, structure at the wall at %s s\n",
               a["peak"].get<double>(), a["peak_time"].get<double>(), a["time"].dump().c_str(),
-              s["front_farthest"].get<double>());
+              s["front_farthest"].get<double>(), s["front_farthest_time"].get<double>(),
+              s["structure_front_wall_time"].dump().c_str());
   EXPECT_GT(a["peak"].get<double>(), 0.2);
   ASSERT_TRUE(a["time"].is_number());
   EXPECT_GT(a["time"].get<double>(), a["peak_time"].get<double>());
@@ -63,6 +67,16 @@ TEST(PaperScenes, AnnularShearBandIsDraggedOutThenReleased) {
   EXPECT_GT(s["front_speed"].get<double>(), 2 * 0.084);
   const auto prof = s["profiles"];
   ASSERT_EQ(prof.size(), 6u);  // 0, 0.1, 0.2, 0.31, 0.45, 0.6 rad
+  // The structure front (f_m(0.505)/2 = 0.15 for hermes2016) only advances, and reaches the wall
+  // between the band's farthest extent and the arrest.
+  EXPECT_NEAR(s["structure_front_threshold"].get<double>(), 0.5 * (0.505 - 0.535) / (0.436 - 0.535), 1e-12);
+  const auto radii = s["structure_front"]["value"].get<std::vector<double>>();
+  ASSERT_GT(radii.size(), 10u);
+  for (std::size_t k = 1; k < radii.size(); ++k) EXPECT_GE(radii[k], radii[k - 1] - 1e-12) << "frame " << k;
+  ASSERT_TRUE(s["structure_front_wall_time"].is_number());
+  const double t_wall = s["structure_front_wall_time"].get<double>();
+  EXPECT_GT(t_wall, s["front_farthest_time"].get<double>());
+  EXPECT_LT(t_wall, a["time"].get<double>());
 }
 
 TEST(PaperScenes, FastWheelRidesHigherAndTravelsFurtherThanTheSlowOne) {
@@ -232,4 +246,8 @@ TEST(PaperScenes, RestartedAnnularRunReportsTheSameProfilesAndFront) {
   ASSERT_GE(full["profiles"].size(), 2u);
   EXPECT_EQ(full["profiles"], part["profiles"]);
   EXPECT_EQ(full["front"], part["front"]);
+  // The sampled structure field is checkpointed too.
+  ASSERT_TRUE(full.contains("structure_front"));
+  EXPECT_GE(full["structure_front"]["value"].size(), 2u);
+  EXPECT_EQ(full["structure_front"], part["structure_front"]);
 }

@@ -143,39 +143,80 @@ double newtonian_distance(const ShearProfile& profile, const AnnularGeometry& ge
   return newtonian_distance(profile.r_m, profile.v_over_ui, geometry.bob_radius_m, geometry.outer_radius_m);
 }
 
-ShearFront jammed_front(const ShearFrame& frame, const AnnularGeometry& geometry, double threshold) {
-  check_geometry(geometry, "jammed_front");
-  check_frame_fits(frame.v_theta, geometry, "jammed_front: v_theta field");
-  if (!std::isfinite(threshold)) throw InputError(fmt::format("jammed_front: threshold {} must be finite", threshold));
-  const GridField2D& f = frame.v_theta;
-  const double omega = geometry.bob_speed_m_per_s / geometry.bob_radius_m;
-  const std::vector<double> row = f.row_at(geometry.sample_z_m, "jammed_front: sample z");
-  const double g0 = sample_line(row, f.origin_x, f.h, geometry.bob_radius_m, "jammed_front: bob radius") /
-                    (omega * geometry.bob_radius_m);
+namespace {
+
+/// Walking outward from the bob along z = sample_z_m, the first radius where value(node value, r)
+/// drops below `threshold` (linear interpolation between nodes; at the bob the value is
+/// interpolated at r_0). `what` names the caller in errors.
+template <class Value>
+ShearFront outward_front(double time_s, const GridField2D& field, const AnnularGeometry& geometry, double threshold,
+                         const std::string& what, Value&& value) {
+  check_geometry(geometry, what.c_str());
+  check_frame_fits(field, geometry, what + ": field");
+  if (!std::isfinite(threshold)) throw InputError(fmt::format("{}: threshold {} must be finite", what, threshold));
+  const std::vector<double> row = field.row_at(geometry.sample_z_m, what + ": sample z");
+  const double g0 = value(sample_line(row, field.origin_x, field.h, geometry.bob_radius_m, what + ": bob radius"),
+                          geometry.bob_radius_m);
   std::vector<double> s, g;
-  for (const std::size_t i : gap_nodes(f, geometry, false)) {
-    const double r = f.x(i);
-    if (r - geometry.bob_radius_m > 1e-9 * f.h) {
+  for (const std::size_t i : gap_nodes(field, geometry, false)) {
+    const double r = field.x(i);
+    if (r - geometry.bob_radius_m > 1e-9 * field.h) {
       s.push_back(r - geometry.bob_radius_m);
-      g.push_back(row[i] / (omega * r));
+      g.push_back(value(row[i], r));
     }
   }
   const LineCrossing c = search_front(0.0, g0, s, g, threshold, FrontSearch::contiguous);
   ShearFront out;
-  out.time_s = frame.time_s;
+  out.time_s = time_s;
   out.found = c.found;
   out.radius_m = geometry.bob_radius_m + c.position;
-  out.at_wall = c.at_end;  // the ratio stays above the threshold up to the last node of the gap
+  out.at_wall = c.at_end;  // the value stays above the threshold up to the last node of the gap
   return out;
+}
+
+template <class Front>
+std::vector<ShearFront> front_series(const std::vector<ShearFrame>& frames, const AnnularGeometry& geometry,
+                                     const char* what, Front&& front_of) {
+  check_frames(frames, geometry, what);
+  std::vector<ShearFront> out;
+  out.reserve(frames.size());
+  for (const ShearFrame& f : frames) out.push_back(front_of(f));
+  return out;
+}
+
+}  // namespace
+
+ShearFront jammed_front(const ShearFrame& frame, const AnnularGeometry& geometry, double threshold) {
+  const double omega = geometry.bob_speed_m_per_s / geometry.bob_radius_m;
+  return outward_front(frame.time_s, frame.v_theta, geometry, threshold, "jammed_front",
+                       [&](double v, double r) { return v / (omega * r); });
+}
+
+ShearFront structure_front(const ShearFrame& frame, const AnnularGeometry& geometry, double f_threshold) {
+  if (frame.f.values.empty()) throw InputError("structure_front: the frame holds no structure field f");
+  return outward_front(frame.time_s, frame.f, geometry, f_threshold, "structure_front",
+                       [](double f, double) { return f; });
 }
 
 std::vector<ShearFront> jammed_front_series(const std::vector<ShearFrame>& frames, const AnnularGeometry& geometry,
                                             double threshold) {
-  check_frames(frames, geometry, "jammed_front_series");
-  std::vector<ShearFront> out;
-  out.reserve(frames.size());
-  for (const ShearFrame& f : frames) out.push_back(jammed_front(f, geometry, threshold));
-  return out;
+  return front_series(frames, geometry, "jammed_front_series",
+                      [&](const ShearFrame& f) { return jammed_front(f, geometry, threshold); });
+}
+
+std::vector<ShearFront> structure_front_series(const std::vector<ShearFrame>& frames, const AnnularGeometry& geometry,
+                                               double f_threshold) {
+  return front_series(frames, geometry, "structure_front_series",
+                      [&](const ShearFrame& f) { return structure_front(f, geometry, f_threshold); });
+}
+
+std::optional<double> front_at_wall_time(const std::vector<ShearFront>& fronts, const AnnularGeometry& geometry,
+                                         double wall_margin_m) {
+  if (!(std::isfinite(wall_margin_m) && wall_margin_m >= 0.0))
+    throw InputError(fmt::format("front_at_wall_time: wall margin = {} m must be finite and >= 0", wall_margin_m));
+  for (const ShearFront& f : fronts)
+    if (f.found && (f.at_wall || geometry.outer_radius_m - f.radius_m <= wall_margin_m)) return f.time_s;
+  return std::nullopt;
 }
 
 TimeSeries front_radius_series(const std::vector<ShearFront>& fronts) {

@@ -20,6 +20,7 @@ namespace oobleck::analysis {
 struct ShearFrame {
   double time_s = 0.0;
   GridField2D v_theta;  ///< azimuthal velocity [m/s] on the (r, z) grid
+  GridField2D f;        ///< micro-structure f of the grains on the same grid (empty: not sampled)
 };
 
 struct AnnularGeometry {
@@ -73,6 +74,21 @@ struct ShearFront {
   double radius_m = 0.0;    ///< front radius (r_0 when not found)
 };
 ShearFront jammed_front(const ShearFrame& frame, const AnnularGeometry& geometry, double threshold = 0.5);
+
+/// Structure front in one frame: walking outward from the bob along z = sample_z_m, the first
+/// radius where the structure f drops below `f_threshold`, linearly interpolated between nodes
+/// (the same search as jammed_front on f instead of the rotation ratio). Where the velocity front
+/// says where the band co-rotates, this one says how far the jammed structure (E24) has spread.
+/// Throws InputError when the frame has no f field.
+ShearFront structure_front(const ShearFrame& frame, const AnnularGeometry& geometry, double f_threshold);
+
+/// structure_front in every frame.
+std::vector<ShearFront> structure_front_series(const std::vector<ShearFrame>& frames, const AnnularGeometry& geometry,
+                                               double f_threshold);
+
+/// First time the front is within wall_margin_m of the outer wall (or reached it); nullopt if never.
+std::optional<double> front_at_wall_time(const std::vector<ShearFront>& fronts, const AnnularGeometry& geometry,
+                                         double wall_margin_m);
 
 /// jammed_front in every frame.
 std::vector<ShearFront> jammed_front_series(const std::vector<ShearFrame>& frames, const AnnularGeometry& geometry,

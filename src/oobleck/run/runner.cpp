@@ -27,6 +27,7 @@
 #include "oobleck/mpm/initial_state.hpp"
 #include "oobleck/mpm/laws.hpp"
 #include "oobleck/mpm/solver.hpp"
+#include "oobleck/rheology/f_max.hpp"
 #include "oobleck/run/finite_check.hpp"
 #include "oobleck/run/third_bodies.hpp"
 
@@ -73,6 +74,10 @@ class SceneRun {
   std::vector<double> series_row() const;
   void write_checkpoint() const;
   void restore(const io::Checkpoint& cp);
+  /// Call f(name, array) for every per-point array of the bodies and laws that a restart needs
+  /// (the one list that write_checkpoint stores and restore reads back).
+  template <class F>
+  void for_each_point_array(F&& f) const;
   void check_finite() const;
   void sample_analysis();
   nlohmann::json parameters() const;
@@ -617,6 +622,32 @@ std::vector<double> SceneRun<G>::series_row() const {
 }
 
 template <class G>
+template <class F>
+void SceneRun<G>::for_each_point_array(F&& f) const {
+  for (int b = 0; b < solver_->body_count(); ++b) {
+    auto& body = solver_->body(b);
+    const std::string p = fmt::format("body{}/", b);
+    f(p + "mass", body.mass_kg);
+    f(p + "volume", body.volume_m3);
+    f(p + "volume0", body.volume0_m3);
+    f(p + "x", as_doubles(body.x_m));
+    f(p + "v", as_doubles(body.v_m_s));
+    f(p + "C", as_doubles(body.C_1_s));
+    f(p + "L", as_doubles(body.L_1_s));
+    f(p + "stress", as_doubles(body.stress_Pa));
+    f(p + "f_ext", as_doubles(body.f_ext_N));
+    f(p + "phi", body.phi);
+    f(p + "div_q", body.div_q_1_s);
+  }
+  if (granular_law_) {
+    f("granular/f", granular_law_->f);
+    f("granular/regime", granular_law_->regime);
+    f("granular/gamma_dot_p", granular_law_->gamma_dot_p);
+  }
+  if (fluid_law_) f("fluid/J", fluid_law_->J);
+}
+
+template <class G>
 void SceneRun<G>::write_checkpoint() const {
   io::CheckpointWriter cp(checkpoint_path(opt_.out_dir));
   cp.set_step(solver_->steps());
@@ -626,27 +657,7 @@ void SceneRun<G>::write_checkpoint() const {
   cp.attribute("threads", static_cast<std::int64_t>(solver_->threads()));
   cp.attribute("settle_sum", settle_sum_);
   cp.attribute("settle_samples", static_cast<std::int64_t>(settle_samples_));
-  for (int b = 0; b < solver_->body_count(); ++b) {
-    auto& body = solver_->body(b);
-    const std::string p = fmt::format("body{}/", b);
-    cp.array(p + "mass", body.mass_kg);
-    cp.array(p + "volume", body.volume_m3);
-    cp.array(p + "volume0", body.volume0_m3);
-    cp.array(p + "x", as_doubles(body.x_m));
-    cp.array(p + "v", as_doubles(body.v_m_s));
-    cp.array(p + "C", as_doubles(body.C_1_s));
-    cp.array(p + "L", as_doubles(body.L_1_s));
-    cp.array(p + "stress", as_doubles(body.stress_Pa));
-    cp.array(p + "f_ext", as_doubles(body.f_ext_N));
-    cp.array(p + "phi", body.phi);
-    cp.array(p + "div_q", body.div_q_1_s);
-  }
-  if (granular_law_) {
-    cp.array("granular/f", granular_law_->f);
-    cp.array("granular/regime", granular_law_->regime);
-    cp.array("granular/gamma_dot_p", granular_law_->gamma_dot_p);
-  }
-  if (fluid_law_) cp.array("fluid/J", fluid_law_->J);
+  for_each_point_array([&](const std::string& name, auto&& a) { cp.array(name, a); });
   for (std::size_t k = 0; k < third_.size(); ++k) {
     const auto& rm = solver_->rigid_motion(third_[k].body);
     cp.array(fmt::format("third{}/rigid_velocity", k), std::span<const double>(rm.velocity_m_s.data(), NC));
@@ -670,6 +681,8 @@ void SceneRun<G>::write_checkpoint() const {
     if (!tips.empty()) cp.array(name + "/tip_z", tips);
   };
   save_fields("analysis/shear", shear_frames_, [](const analysis::ShearFrame& f) -> const analysis::GridField2D& { return f.v_theta; });
+  if (!shear_frames_.empty() && !shear_frames_.front().f.values.empty())
+    save_fields("analysis/shear_f", shear_frames_, [](const analysis::ShearFrame& f) -> const analysis::GridField2D& { return f.f; });
   save_fields("analysis/uz", uz_frames_, [](const analysis::IntrusionFrame& f) -> const analysis::GridField2D& { return f.field; });
   save_fields("analysis/f", f_frames_, [](const analysis::IntrusionFrame& f) -> const analysis::GridField2D& { return f.field; });
   if (!track_.empty()) {
@@ -693,27 +706,7 @@ void SceneRun<G>::restore(const io::Checkpoint& cp) {
     throw InputError(fmt::format("{}: time step {} s differs from the checkpoint's {} s", cp.file(), dt_,
                                  cp.real_attribute("dt")));
   }
-  for (int b = 0; b < solver_->body_count(); ++b) {
-    auto& body = solver_->body(b);
-    const std::string p = fmt::format("body{}/", b);
-    cp.read_into(p + "mass", body.mass_kg);
-    cp.read_into(p + "volume", body.volume_m3);
-    cp.read_into(p + "volume0", body.volume0_m3);
-    cp.read_into(p + "x", as_doubles(body.x_m));
-    cp.read_into(p + "v", as_doubles(body.v_m_s));
-    cp.read_into(p + "C", as_doubles(body.C_1_s));
-    cp.read_into(p + "L", as_doubles(body.L_1_s));
-    cp.read_into(p + "stress", as_doubles(body.stress_Pa));
-    cp.read_into(p + "f_ext", as_doubles(body.f_ext_N));
-    cp.read_into(p + "phi", body.phi);
-    cp.read_into(p + "div_q", body.div_q_1_s);
-  }
-  if (granular_law_) {
-    cp.read_into("granular/f", granular_law_->f);
-    cp.read_into("granular/regime", granular_law_->regime);
-    cp.read_into("granular/gamma_dot_p", granular_law_->gamma_dot_p);
-  }
-  if (fluid_law_) cp.read_into("fluid/J", fluid_law_->J);
+  for_each_point_array([&](const std::string& name, auto&& a) { cp.read_into(name, a); });
   for (std::size_t k = 0; k < third_.size(); ++k) {
     auto& rm = solver_->rigid_motion(third_[k].body);
     cp.read_into(fmt::format("third{}/rigid_velocity", k), std::span<double>(rm.velocity_m_s.data(), NC));
@@ -751,6 +744,12 @@ void SceneRun<G>::restore(const io::Checkpoint& cp) {
       fr.v_theta = std::move(f);
       return fr;
     });
+    std::vector<analysis::GridField2D> shear_f;
+    load_fields("analysis/shear_f", shear_f, shape, [](double, analysis::GridField2D f, std::size_t) { return f; });
+    if (!shear_f.empty() && shear_f.size() != shear_frames_.size())
+      throw InputError(fmt::format("{}: 'analysis/shear_f' has {} frames, 'analysis/shear' {}", cp.file(),
+                                   shear_f.size(), shear_frames_.size()));
+    for (std::size_t k = 0; k < shear_f.size(); ++k) shear_frames_[k].f = std::move(shear_f[k]);
     for (auto [name, frames] : {std::pair{"analysis/uz", &uz_frames_}, std::pair{"analysis/f", &f_frames_}}) {
       const std::vector<double> tips = cp.has(std::string(name) + "/tip_z") ? cp.doubles(std::string(name) + "/tip_z")
                                                                              : std::vector<double>{};
@@ -855,6 +854,9 @@ void SceneRun<G>::sample_shear_frame() {
         fr.v_theta.values[j * fr.v_theta.nx + i] = m > 0 ? mv / m : 0.0;
       }
     }
+    if (grains_ >= 0 && granular_law_)  // the structure, for the structure front
+      fr.f = nodal_average<G>(grid, {&solver_->body(grains_)},
+                              [&](std::size_t, std::int64_t p) { return granular_law_->f[static_cast<std::size_t>(p)]; });
     shear_frames_.push_back(std::move(fr));
   }
 }
@@ -950,7 +952,7 @@ nlohmann::json SceneRun<G>::analysis_result() const {
     a["bob_angle_final_rad"] = max_angle;
     const auto fronts = analysis::jammed_front_series(shear_frames_, geo);
     // The front speed is fitted while the front advances: up to its farthest extent (after that
-    // the band unjams and the front criterion recedes, see docs/results.md).
+    // the co-rotation fades and the front criterion recedes, see docs/results.md).
     const auto radii = analysis::front_radius_series(fronts);
     a["front"] = analysis::to_json(radii);
     double t_farthest = INFINITY;
@@ -980,6 +982,15 @@ nlohmann::json SceneRun<G>::analysis_result() const {
     const auto outer = analysis::outer_rotation_series(shear_frames_, geo);
     a["outer_rotation"] = analysis::to_json(outer);
     a["outer_arrest"] = analysis::to_json(analysis::outer_arrest(outer, 0.1));
+    // How far the jammed structure has spread: f >= half its E9 limit f_m(phi) of the bed.
+    if (!shear_frames_.front().f.values.empty()) {
+      const double f_thr = 0.5 * rheology::f_m(cfg_.material.steady, cfg_.regions.front().phi);
+      const auto sfronts = analysis::structure_front_series(shear_frames_, geo, f_thr);
+      a["structure_front"] = analysis::to_json(analysis::front_radius_series(sfronts));
+      a["structure_front_threshold"] = f_thr;
+      const auto t_wall = analysis::front_at_wall_time(sfronts, geo, cfg_.grid.cell_size_m);
+      a["structure_front_wall_time"] = t_wall ? nlohmann::json(*t_wall) : nlohmann::json(nullptr);
+    }
   }
   if (cfg_.analysis.kind == scene::AnalysisKind::Couette && fluid_ >= 0 && NC == 3) {
     // Torque on a coaxial cylinder of radius r: M(r) = 2 pi r^2 H tau_r_theta (whole cylinder).
