@@ -294,7 +294,7 @@ template <int D, class Kernel>
 [[gnu::always_inline]]
 #endif
 inline bool make_stencil(const Grid<D>& grid, const StencilGrid<D>& sg, const Kernel& kernel, const Vec<D>& x,
-                         Stencil<D, Kernel::support>& s, double* inv_D) {
+                         Stencil<D, Kernel::support>& s, Vec<D>& inv_D) {
   constexpr int S = Kernel::support;
   bool ok = true;
   for (int a = 0; a < D; ++a) {
@@ -324,7 +324,7 @@ inline bool make_stencil(const Grid<D>& grid, const StencilGrid<D>& sg, const Ke
         s.index[a][j] = in ? st * sg.stride[a] : 0;
       }
     }
-    if (inv_D) inv_D[a] = m2 > 0.0 ? 1.0 / m2 : 0.0;
+    inv_D[a] = m2 > 0.0 ? 1.0 / m2 : 0.0;
   }
   return ok;
 }
@@ -341,7 +341,7 @@ std::int64_t compute_shape_cache(const Grid<D>& grid, const Kernel& kernel, cons
   std::int64_t bad = 0;
 #pragma omp parallel for schedule(static) reduction(+ : bad)
   for (std::int64_t p = 0; p < np; ++p)
-    if (!make_stencil(grid, sg, kernel, x[p], cache.template stencil<Kernel::support>(p), cache.inv_D[p].data())) ++bad;
+    if (!make_stencil(grid, sg, kernel, x[p], cache.template stencil<Kernel::support>(p), cache.inv_D[p])) ++bad;
   return bad;
 }
 
