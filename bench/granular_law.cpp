@@ -112,6 +112,40 @@ void run(benchmark::State& bs, const std::vector<Case>& cases, const material::G
   bs.counters["implicit_f"] = static_cast<double>(implicit) / static_cast<double>(bs.iterations());
 }
 
+/// The MPM adapter's forms: advance() point by point, or advance_batch() over all cases at once
+/// (the f_1 and p_tr <= 0 Newton solves in lanes across points). Items: point updates.
+void run_hot(benchmark::State& bs, const std::vector<Case>& cases, const material::GranularLaw& L, double dt,
+             bool batch) {
+  const auto n = static_cast<std::int64_t>(cases.size());
+  std::vector<Eigen::Matrix3d> sigma0(cases.size()), sigma(cases.size()), Lv(cases.size());
+  std::vector<double> f0(cases.size()), f(cases.size()), phi(cases.size());
+  std::vector<material::GranularStep> step(cases.size());
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    sigma0[k] = cases[k].state.sigma;
+    f0[k] = cases[k].state.f;
+    Lv[k] = cases[k].D + cases[k].W;
+    phi[k] = cases[k].phi;
+  }
+  for (auto _ : bs) {
+    sigma = sigma0;
+    f = f0;
+    if (batch) {
+      L.advance_batch(n, sigma.data(), f.data(), Lv.data(), phi.data(), dt, step.data());
+    } else {
+      for (std::size_t k = 0; k < cases.size(); ++k) {
+        material::GranularState s{sigma[k], f[k]};
+        const Eigen::Matrix3d D = 0.5 * (Lv[k] + Lv[k].transpose()), W = 0.5 * (Lv[k] - Lv[k].transpose());
+        step[k] = L.advance(s, D, W, dt, phi[k]);
+        sigma[k] = s.sigma;
+        f[k] = s.f;
+      }
+    }
+    benchmark::DoNotOptimize(sigma.data());
+    benchmark::DoNotOptimize(f.data());
+  }
+  bs.SetItemsProcessed(bs.iterations() * n);
+}
+
 void BM_GranularUpdateMix(benchmark::State& bs) {
   static const std::vector<Case> cases = make_mix(4096);
   run(bs, cases);
@@ -214,6 +248,32 @@ BENCHMARK(BM_GranularUpdateLooseBedIntruder);
 // wheel bed: G = 3.8e5, K = 8.3e5 Pa, K_0 = 1, eta_0 = 1e-3 Pa s, phi = 0.482, dt = 2e-5 s
 void BM_GranularUpdateLooseBedWheel(benchmark::State& bs) { loose_bed(bs, {3.8e5, 8.3e5, 1.0, 1e-3, 0.482, 2e-5}); }
 BENCHMARK(BM_GranularUpdateLooseBedWheel);
+
+// The same beds and the mix through the MPM adapter's calls: advance() per point vs advance_batch().
+void loose_bed_hot(benchmark::State& bs, const LooseBed& b, bool batch) {
+  const material::GranularLaw L = loose_bed_law(b);
+  static std::vector<Case> cases;
+  cases = make_loose_bed(b, 4096);
+  run_hot(bs, cases, L, b.dt, batch);
+}
+void BM_AdvanceLooseBedWheel(benchmark::State& bs) { loose_bed_hot(bs, {3.8e5, 8.3e5, 1.0, 1e-3, 0.482, 2e-5}, false); }
+void BM_AdvanceBatchLooseBedWheel(benchmark::State& bs) {
+  loose_bed_hot(bs, {3.8e5, 8.3e5, 1.0, 1e-3, 0.482, 2e-5}, true);
+}
+void BM_AdvanceLooseBedIntruder(benchmark::State& bs) {
+  loose_bed_hot(bs, {3.8e7, 8.3e7, 0.2, 4.6e-3, 0.47, 1e-6}, false);
+}
+void BM_AdvanceBatchLooseBedIntruder(benchmark::State& bs) {
+  loose_bed_hot(bs, {3.8e7, 8.3e7, 0.2, 4.6e-3, 0.47, 1e-6}, true);
+}
+void BM_AdvanceMix(benchmark::State& bs) { run_hot(bs, make_mix(4096), law(), 1e-6, false); }
+void BM_AdvanceBatchMix(benchmark::State& bs) { run_hot(bs, make_mix(4096), law(), 1e-6, true); }
+BENCHMARK(BM_AdvanceLooseBedWheel);
+BENCHMARK(BM_AdvanceBatchLooseBedWheel);
+BENCHMARK(BM_AdvanceLooseBedIntruder);
+BENCHMARK(BM_AdvanceBatchLooseBedIntruder);
+BENCHMARK(BM_AdvanceMix);
+BENCHMARK(BM_AdvanceBatchMix);
 
 }  // namespace
 

@@ -5,7 +5,10 @@
 // yield conditions, which are re-evaluated here from E18–E23 independently of the law's code.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -166,3 +169,81 @@ void sweep(const std::string& preset_name, int n, std::uint64_t seed, double K_0
 
 TEST(GranularRobustness, RandomSweepHermes) { sweep("hermes2016", 100000, 12345); }
 TEST(GranularRobustness, RandomSweepDhaeneFastStructure) { sweep("dhaene1993", 20000, 777, 50.0); }
+
+namespace {
+
+// advance_batch (the MPM adapter's call: Newton solves in lanes across points) must give the
+// results of advance() point by point, bit for bit, in every regime and on failures: random
+// states as in the sweep above (one dt per batch), a loose bed as in the bench set-ups, and a few
+// invalid inputs (non-finite L, phi outside (0, 1)).
+void batch_equals_point_by_point(const std::string& preset_name, std::uint64_t seed, double dt, bool loose) {
+  const rheology::Preset P = test::preset(preset_name);
+  const material::GranularLaw law(P);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  const int n = 3000;
+  std::vector<Eigen::Matrix3d> sigma(n), L(n);
+  std::vector<double> f(n), phi(n);
+  for (int k = 0; k < n; ++k) {
+    phi[k] = loose ? 0.47 + 0.02 * U(rng) : 0.3 + 0.3 * U(rng);
+    f[k] = loose ? (U(rng) < 0.2 ? 0.0 : log_uniform(rng, 1e-22, 1e-3)) : U(rng);
+    const double p = (U(rng) < (loose ? 0.5 : 0.2) ? -1.0 : 1.0) * (loose ? log_uniform(rng, 1e-12, 1e-2)
+                                                                          : log_uniform(rng, 1e-3, 1e6));
+    Eigen::Matrix3d s = random_tensor(rng, 1.0);
+    s = 0.5 * (s + s.transpose()).eval();
+    s.diagonal().array() -= s.trace() / 3.0;
+    sigma[k] = std::sqrt(2.0) * (0.1 + 3.0 * U(rng)) * std::fabs(p) * s / s.norm();
+    sigma[k].diagonal().array() -= p;
+    L[k] = random_tensor(rng, loose ? log_uniform(rng, 1e-5, 1e-1) : log_uniform(rng, 1e-3, 1e4));
+  }
+  L[7](0, 1) = std::numeric_limits<double>::quiet_NaN();  // invalid inputs: reported, state kept
+  phi[11] = 1.0;
+  phi[2999] = 0.0;
+  std::vector<Eigen::Matrix3d> sigma_b = sigma, sigma_p = sigma;
+  std::vector<double> f_b = f, f_p = f;
+  std::vector<material::GranularStep> step_b(n), step_p(n);
+  law.advance_batch(n, sigma_b.data(), f_b.data(), L.data(), phi.data(), dt, step_b.data());
+  int counts[5] = {0, 0, 0, 0, 0}, mismatches = 0, not_ok = 0;
+  for (int k = 0; k < n; ++k) {
+    Eigen::Matrix3d D, W;
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) {
+        D(i, j) = 0.5 * (L[k](i, j) + L[k](j, i));
+        W(i, j) = 0.5 * (L[k](i, j) - L[k](j, i));
+      }
+    material::GranularState st{sigma_p[k], f_p[k]};
+    step_p[k] = law.advance(st, D, W, dt, phi[k]);
+    if (step_p[k].ok) {
+      sigma_p[k] = st.sigma;
+      f_p[k] = st.f;
+    }
+    counts[static_cast<int>(step_p[k].regime)]++;
+    not_ok += step_p[k].ok ? 0 : 1;
+    const bool same = std::memcmp(sigma_b[k].data(), sigma_p[k].data(), 9 * sizeof(double)) == 0 &&
+                      std::memcmp(&f_b[k], &f_p[k], sizeof(double)) == 0 && step_b[k].ok == step_p[k].ok &&
+                      step_b[k].regime == step_p[k].regime &&
+                      std::memcmp(&step_b[k].gamma_dot_p, &step_p[k].gamma_dot_p, sizeof(double)) == 0;
+    if (!same && ++mismatches <= 5)
+      ADD_FAILURE() << "point " << k << ": batch and point-by-point results differ (phi = " << phi[k] << ")";
+  }
+  EXPECT_EQ(mismatches, 0);
+  EXPECT_EQ(not_ok, 3);  // exactly the three invalid inputs
+  // the batch must have met the regimes whose Newton solves it runs in lanes
+  EXPECT_GT(counts[static_cast<int>(GranularRegime::kShear)], n / 20);
+  EXPECT_GT(counts[static_cast<int>(GranularRegime::kShearCompaction)] + counts[static_cast<int>(GranularRegime::kCompaction)],
+            n / 20);
+  if (!loose) {
+    EXPECT_GT(counts[static_cast<int>(GranularRegime::kSeparated)], 5);
+  }
+}
+
+}  // namespace
+
+TEST(GranularRobustness, BatchEqualsPointByPointRandomStates) {
+  batch_equals_point_by_point("hermes2016", 99, 1e-5, false);
+  batch_equals_point_by_point("dhaene1993", 98, 1e-3, false);
+}
+TEST(GranularRobustness, BatchEqualsPointByPointLooseBed) {
+  batch_equals_point_by_point("hermes2016", 97, 2e-5, true);
+  batch_equals_point_by_point("hermes2016", 96, 1e-6, true);
+}

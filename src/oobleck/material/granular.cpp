@@ -115,10 +115,176 @@ inline void jaumann_trial(const Eigen::Matrix3d& S, const Eigen::Matrix3d& D, co
   for (int i = 0; i < 3; ++i) r(i, i) += vol;
 }
 
+// ---- The f_1-only branch of the return map in u = I_m (docs/granular.md), shared by the scalar
+// solve and the lanes of advance_batch so that both do the same arithmetic. Both sides of every
+// select are computed (no division under a condition), so the lane loop vectorises.
+}  // namespace
+namespace granular_detail {
+struct F1Consts {
+  double Kdt, Gdt, two_eta, d2_rho_s, K_3, mu_1, mu_2, b;
+};
+struct F1Value {
+  double g, p, R, be, mq, disc;
+};
+/// The p_tr > 0 branch's value at u = u_eq (e_lo: decides between f_1 + f_3 and f_1) and the f_1 +
+/// f_3 closed form (E21, E23 with K_4 = 0; beta = 0, I_m = u_eq).
+struct Compressive {
+  F1Value e_lo;
+  double g, p, tau, xi2;
+};
+}  // namespace granular_detail
+using granular_detail::Compressive;
+using granular_detail::F1Consts;
+using granular_detail::F1Value;
+namespace {
+
+/// For given u the pressure balance p = p_tr + K dt beta(u) gamma_dot with p = Q(gamma_dot)/u^2 (E18,
+/// E19) is a quadratic in gamma_dot with one positive root; R(u) = tau_tr - G dt gamma_dot - mu_p p
+/// is the E21 residual, mu_p from E20.
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void f1_value(const F1Consts& c, double phi, double phi_m, double a, double visc, double p_tr, double tau_tr,
+                     double uu, F1Value& e) {
+  e.be = c.K_3 * (phi - phi_m / (1.0 + a * uu));  // E18 beta
+  const double A2 = c.d2_rho_s;
+  const double B2 = c.two_eta - c.Kdt * e.be * uu * uu;
+  const double C2 = p_tr * uu * uu;
+  e.disc = std::sqrt(B2 * B2 + 4.0 * A2 * C2);
+  const double g_plus = 2.0 * C2 / (B2 + e.disc), g_minus = (e.disc - B2) / (2.0 * A2);
+  e.g = B2 >= 0.0 ? g_plus : g_minus;
+  e.p = p_tr + c.Kdt * e.be * e.g;
+  const double mq_b = c.mu_1 + (c.mu_2 - c.mu_1) * uu / (uu + c.b);  // E20 mu_q
+  e.mq = c.b == 0.0 ? c.mu_2 : mq_b;
+  // viscous friction term of E20 times p: (5/2) phi/a * I_v/I_m * p = visc * g/u
+  const double g_over_u = e.g / uu;
+  const double gv = uu > 0.0 ? g_over_u : 0.0;
+  e.R = tau_tr - c.Gdt * e.g - (e.mq + e.be) * e.p - visc * gv;
+}
+
+/// dR/du at the value e (implicit derivatives of the quadratic's root).
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline double f1_slope(const F1Consts& c, double phi_m, double a, double visc, double p_tr, double uu,
+                       const F1Value& e) {
+  const double q = 1.0 + a * uu;
+  const double be = e.be, dbe = c.K_3 * phi_m * a / (q * q);
+  const double dB2 = -c.Kdt * (dbe * uu * uu + 2.0 * be * uu);
+  const double dC2 = 2.0 * p_tr * uu;
+  const double dg_d = (dC2 - dB2 * e.g) / e.disc;
+  const double dg = e.disc > 0.0 ? dg_d : 0.0;
+  const double dp = c.Kdt * (dbe * e.g + be * dg);
+  const double dmq_b = (c.mu_2 - c.mu_1) * c.b / ((uu + c.b) * (uu + c.b));
+  const double dmq = c.b == 0.0 ? 0.0 : dmq_b;
+  const double dgv_u = dg / uu - e.g / (uu * uu);
+  const double dgv = uu > 0.0 ? dgv_u : p_tr / c.two_eta;  // g ~ p_tr u^2/(2 eta_0) as u -> 0
+  return -c.Gdt * dg - (dmq + dbe) * e.p - (e.mq + be) * dp - visc * dgv;
+}
+
+/// One Newton/bracketing step of the f_1 solve after the value R and slope dR at x (in the order of
+/// the scalar loop): 0 = continue at x, 1 = converged at x (|R| small), 2 = step converged: x is the
+/// new point, evaluate once more and stop.
+inline int f1_step(double R, double dR, double tau_tr, double tol, double& x, double& lo, double& hi) {
+  if (std::fabs(R) <= 1e-14 * tau_tr) return 1;
+  if (R > 0.0) lo = x; else hi = x;
+  double next = (dR < 0.0) ? x - R / dR : -1.0;
+  const bool newton = next > lo && next < hi;
+  if (!newton) next = (lo > 0.0 && hi > 4.0 * lo) ? std::sqrt(lo * hi) : 0.5 * (lo + hi);
+  const bool step_done = (newton && std::fabs(next - x) <= tol * x) || (hi - lo) <= tol * hi;
+  x = next;
+  return step_done ? 2 : 0;
+}
+
+/// Compressive: the value at u_eq and the f_1 + f_3 closed form, tau_tr - G dt g = mu_q p + visc g/u_eq
+/// with p = Q(g)/u_eq^2, a quadratic A g^2 + B g - C = 0. Branch-free (computed where unused too),
+/// so that advance_batch evaluates it for a block of points in lanes.
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void compressive(const F1Consts& c, double phi, double phi_m, double a, double visc, double p_tr,
+                        double tau_tr, double u_eq, F1Value& e_lo, double& g, double& p, double& tau, double& xi2) {
+  f1_value(c, phi, phi_m, a, visc, p_tr, tau_tr, u_eq, e_lo);
+  const double mq_b = c.mu_1 + (c.mu_2 - c.mu_1) * u_eq / (u_eq + c.b);
+  const double mq = c.b == 0.0 ? c.mu_2 : mq_b;
+  const double u2 = u_eq * u_eq;
+  const double A = mq * c.d2_rho_s;
+  const double B = c.Gdt * u2 + mq * c.two_eta + visc * u_eq;
+  const double C = tau_tr * u2;
+  g = 2.0 * C / (B + std::sqrt(B * B + 4.0 * A * C));
+  p = std::min((g * (g * c.d2_rho_s + c.two_eta)) / u2, p_tr);  // <= p_tr by construction; min guards round-off
+  // tau_bar from the friction side of E21 (tau_tr - G dt g cancels when G dt g >> tau_bar)
+  tau = std::min(mq * p + visc * g / u_eq, tau_tr);
+  xi2 = std::min((p - p_tr) / c.Kdt, 0.0);  // E23: xi_dot_2 <= 0
+}
+
+/// E20 mu_q(I_m) (GranularLaw::mu_q) with the constants of c.
+inline double f1_mu_q(const F1Consts& c, double uu) {
+  if (c.b == 0.0) return c.mu_2;
+  return c.mu_1 + (c.mu_2 - c.mu_1) * uu / (uu + c.b);
+}
+
+/// Friction side of E21 at (gamma_dot, p, I_m): max((mu_p + beta) p, 0), with E20 written as
+/// mu_p p = mu_q(I_m) p + (5/2)(phi/a) eta_0 gamma_dot/I_m; beta from E18.
+inline double friction_of(const F1Consts& c, double phi, double phi_m, double a, double visc, double gg, double pp,
+                          double uu) {
+  if (!(pp > 0.0)) return 0.0;
+  if (!(uu > 0.0)) return std::max((f1_mu_q(c, 0.0) + c.K_3 * (phi - phi_m / (1.0 + a * 0.0))) * pp, 0.0);
+  return std::max((f1_mu_q(c, uu) + c.K_3 * (phi - phi_m / (1.0 + a * uu))) * pp + visc * gg / uu, 0.0);
+}
+
+/// One Newton step of the p_tr <= 0 fast path on the pair (gamma_dot, u = I_m) (return_map), shared
+/// by the scalar loop and the lanes of advance_batch; computed without branches. Returns 1 when the
+/// residuals at (gg, uu) are at round-off level (pp, Rr are the values there; gg, uu unchanged),
+/// 2 when the step fails (singular Jacobian: unchanged; or the update leaves the admissible range),
+/// 3 when the update is below rel_tol in both unknowns, 0 to continue from the updated (gg, uu).
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline double tension_step(const F1Consts& c, double phi, double phi_m, double a, double visc, double p_tr,
+                        double tau_tr, double g_max, double tol, double& gg, double& uu, double& pp_out,
+                        double& Rr_out) {
+  const double iu = 1.0 / uu;
+  const double Qp = 2.0 * gg * c.d2_rho_s + c.two_eta;
+  const double pp = (gg * (gg * c.d2_rho_s + c.two_eta)) * iu * iu;
+  const double iq = 1.0 / (1.0 + a * uu);
+  const double be = c.K_3 * (phi - phi_m * iq), dbe = c.K_3 * phi_m * a * iq * iq;
+  const double mq_b = c.mu_1 + (c.mu_2 - c.mu_1) * uu / (uu + c.b);
+  const double mq = c.b == 0.0 ? c.mu_2 : mq_b;
+  const double dmq_b = (c.mu_2 - c.mu_1) * c.b / ((uu + c.b) * (uu + c.b));
+  const double dmq = c.b == 0.0 ? 0.0 : dmq_b;
+  const double h = pp - p_tr - c.Kdt * gg * be;
+  const double Rr = tau_tr - c.Gdt * gg - (mq + be) * pp - visc * gg * iu;
+  // residual exit with the tolerances of the nested solve (|R| <= 1e-14 tau_tr, pressure balance to
+  // 1e-15 of its terms)
+  const bool fast = (std::fabs(Rr) <= 1e-14 * tau_tr) & (std::fabs(h) <= 1e-15 * (std::fabs(p_tr) + pp)) & (be >= 0.0);
+  const double hg = Qp * iu * iu - c.Kdt * be, hu = -2.0 * pp * iu - c.Kdt * gg * dbe;
+  const double Rg = -c.Gdt - (mq + be) * Qp * iu * iu - visc * iu;
+  const double Ru = -(dmq + dbe) * pp + 2.0 * (mq + be) * pp * iu + visc * gg * iu * iu;
+  const double det = hg * Ru - hu * Rg;
+  const bool singular = !(std::fabs(det) > 0.0);
+  const double dg = (hu * Rr - h * Ru) / det;
+  const double du = (h * Rg - hg * Rr) / det;
+  const double g1 = gg + dg, u1 = uu + du;
+  const bool in_range =
+      (g1 > 0.0) & (g1 <= g_max) & (u1 > 0.0) & (std::fabs(u1) <= std::numeric_limits<double>::max());
+  const bool small = (std::fabs(dg) <= tol * g1) & (std::fabs(du) <= tol * u1);
+  pp_out = pp;
+  Rr_out = Rr;
+  const bool keep = fast | singular;
+  gg = keep ? gg : g1;
+  uu = keep ? uu : u1;
+  // (a double, so that the lane loop has one element width)
+  const double st = small ? 3.0 : 0.0;
+  const double st2 = (singular | !in_range) ? 2.0 : st;
+  return fast ? 1.0 : st2;
+}
+
 }  // namespace
 
 GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_0, double dt, double p_tr,
-                                               double tau_tr) const {
+                                               double tau_tr, F1Job* defer, TensionJob* defer2,
+                                               const Compressive* pre) const {
   const double tol = options_.rel_tol;
   const int cap = options_.max_iter;
   // ---- E1, E2 with the structure used by this return map (f_n when staggered) ----
@@ -150,11 +316,8 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
 
   // Friction side of E21 at (gamma_dot, p, I_m): max((mu_p + beta) p, 0), with E20 written as
   // mu_p p = mu_q(I_m) p + (5/2)(phi/a) eta_0 gamma_dot/I_m.
-  auto friction = [&](double gg, double pp, double uu) {
-    if (!(pp > 0.0)) return 0.0;
-    if (!(uu > 0.0)) return std::max((mu_q(0.0) + beta_of(0.0)) * pp, 0.0);
-    return std::max((mu_q(uu) + beta_of(uu)) * pp + visc * gg / uu, 0.0);
-  };
+  const F1Consts c{Kdt, Gdt, two_eta, d2_rho_s_, K_3_, mu_1_, mu_2_, b_};
+  auto friction = [&](double gg, double pp, double uu) { return friction_of(c, phi, phi_m, a, visc, gg, pp, uu); };
 
   // ---- General shear solve in gamma_dot (used for p_tr <= 0 and as the fallback of the fast path).
   // Inner: for fixed gamma_dot the pressure balance, written in u = I_m with p = Q(gamma_dot)/u^2,
@@ -262,67 +425,23 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
       tau = tau_tr;
       p = p_tr;
     } else {
-      // Fast path, parametrised by u = I_m >= u_eq (beta >= 0, xi_dot_2 = 0): for given u the
-      // pressure balance p = p_tr + K dt beta(u) gamma_dot with p = Q(gamma_dot)/u^2 is a quadratic
-      // in gamma_dot with one positive root; R(u) = tau_tr - G dt gamma_dot - (mu_p + beta) p is the
-      // E21 residual (decreasing in u, see docs/granular.md).
-      // The value (g, p, R) and the derivatives (dg, dp, dR) are separate steps: the f_1 + f_3
-      // branch below needs only the value at u_eq.
-      struct Eval {
-        double g, dg, p, dp, R, dR;
-        double u, be, mq, disc, gv;  // intermediates of the value reused by the derivatives
-      };
-      auto eval_value = [&](double uu) {
-        Eval e{};
-        e.u = uu;
-        e.be = beta_of(uu);
-        const double A2 = d2_rho_s_;
-        const double B2 = two_eta - Kdt * e.be * uu * uu;
-        const double C2 = p_tr * uu * uu;
-        e.disc = std::sqrt(B2 * B2 + 4.0 * A2 * C2);
-        e.g = B2 >= 0.0 ? 2.0 * C2 / (B2 + e.disc) : (e.disc - B2) / (2.0 * A2);
-        e.p = p_tr + Kdt * e.be * e.g;
-        e.mq = mu_q(uu);
-        // viscous friction term of E20 times p: (5/2) phi/a * I_v/I_m * p = visc * g/u
-        e.gv = uu > 0.0 ? e.g / uu : 0.0;
-        e.R = tau_tr - Gdt * e.g - (e.mq + e.be) * e.p - visc * e.gv;
-        return e;
-      };
-      auto eval_derivatives = [&](Eval& e) {
-        const double uu = e.u, be = e.be, dbe = dbeta_of(uu);
-        const double dB2 = -Kdt * (dbe * uu * uu + 2.0 * be * uu);
-        const double dC2 = 2.0 * p_tr * uu;
-        e.dg = e.disc > 0.0 ? (dC2 - dB2 * e.g) / e.disc : 0.0;
-        e.dp = Kdt * (dbe * e.g + be * e.dg);
-        const double dmq = b_ == 0.0 ? 0.0 : (mu_2_ - mu_1_) * b_ / ((uu + b_) * (uu + b_));
-        const double dgv = uu > 0.0 ? e.dg / uu - e.g / (uu * uu)
-                                    : p_tr / two_eta;  // g ~ p_tr u^2/(2 eta_0) as u -> 0
-        e.dR = -Gdt * e.dg - (dmq + dbe) * e.p - (e.mq + be) * e.dp - visc * dgv;
-      };
-      auto eval = [&](double uu) {
-        Eval e = eval_value(uu);
-        eval_derivatives(e);
-        return e;
-      };
-      Eval e_lo = eval_value(u_eq);
+      // Fast path, parametrised by u = I_m >= u_eq (beta >= 0, xi_dot_2 = 0): f1_value, R(u)
+      // decreasing in u (docs/granular.md). Its value at u_eq decides between f_1 + f_3 and f_1.
+      Compressive cm_own;
+      if (pre == nullptr) compressive(c, phi, phi_m, a, visc, p_tr, tau_tr, u_eq, cm_own.e_lo, cm_own.g, cm_own.p, cm_own.tau, cm_own.xi2);
+      const Compressive& cm = pre != nullptr ? *pre : cm_own;
+      const F1Value& e_lo = cm.e_lo;
       if (e_lo.R <= 0.0 && u_eq > 0.0) {
         // -------- f_1 + f_3 (E21, E23 with K_4 = 0): beta = 0, I_m = u_eq; closed form ----------
-        // tau_tr - G dt g = mu_q p + visc g/u_eq with p = Q(g)/u_eq^2: quadratic A g^2 + B g - C = 0.
-        const double mq = mu_q(u_eq);
-        const double u2 = u_eq * u_eq;
-        const double A = mq * d2_rho_s_;
-        const double B = Gdt * u2 + mq * two_eta + visc * u_eq;
-        const double C = tau_tr * u2;
-        g = 2.0 * C / (B + std::sqrt(B * B + 4.0 * A * C));
-        p = std::min(Q_of(g) / u2, p_tr);  // <= p_tr by construction; min guards round-off
-        // tau_bar from the friction side of E21 (tau_tr - G dt g cancels when G dt g >> tau_bar)
-        tau = std::min(mq * p + visc * g / u_eq, tau_tr);
+        g = cm.g;
+        p = cm.p;
+        tau = cm.tau;
         u = u_eq;
-        xi2 = std::min((p - p_tr) / Kdt, 0.0);  // E23: xi_dot_2 <= 0
+        xi2 = cm.xi2;
         regime = g > 0.0 ? GranularRegime::kShearCompaction : GranularRegime::kCompaction;
       } else {
         // -------- f_1 only: root of R(u) on [u_lo, u_hi] --------
-        eval_derivatives(e_lo);
+        const double e_lo_dR = f1_slope(c, phi_m, a, visc, p_tr, u_eq, e_lo);
         double lo = u_eq, hi;
         // Upper bracket: with beta >= 0, gamma_dot(u) >= the beta = 0 root, so gamma_dot(u_hi) >= gamma_max
         // when Q(gamma_max)/u_hi^2 <= p_tr; there R <= -(mu_p + beta) p < 0.
@@ -340,30 +459,32 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
                                         : 0.5 * (lo + hi);
           if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
           // Near a steady state the root sits just above u_eq: a Newton step from the lower end is better.
-          if (e_lo.dR < 0.0) {
-            const double xn = lo - e_lo.R / e_lo.dR;
+          if (e_lo_dR < 0.0) {
+            const double xn = lo - e_lo.R / e_lo_dR;
             if (xn > lo && xn < x) x = xn;
           }
         }
-        Eval e{};
+        if (defer != nullptr) {  // advance_batch runs the Newton iterations in lanes
+          *defer = F1Job{phi, phi_m, a, visc, p_tr, tau_tr, x, lo, hi};
+          ReturnMap r;
+          r.deferred = true;
+          return r;
+        }
+        F1Value e{};
         converged = false;
         for (iterations = 1; iterations <= cap; ++iterations) {
-          e = eval(x);
-          if (std::fabs(e.R) <= 1e-14 * tau_tr) {
+          f1_value(c, phi, phi_m, a, visc, p_tr, tau_tr, x, e);
+          const double dR = f1_slope(c, phi_m, a, visc, p_tr, x, e);
+          const int st = f1_step(e.R, dR, tau_tr, tol, x, lo, hi);
+          if (st == 1) {
             converged = true;
             break;
           }
-          if (e.R > 0.0) lo = x; else hi = x;
-          double next = (e.dR < 0.0) ? x - e.R / e.dR : -1.0;
-          const bool newton = next > lo && next < hi;
-          if (!newton) next = (lo > 0.0 && hi > 4.0 * lo) ? std::sqrt(lo * hi) : 0.5 * (lo + hi);
-          if ((newton && std::fabs(next - x) <= tol * x) || (hi - lo) <= tol * hi) {
-            x = next;
-            e = eval(x);
+          if (st == 2) {
+            f1_value(c, phi, phi_m, a, visc, p_tr, tau_tr, x, e);
             converged = true;
             break;
           }
-          x = next;
         }
         residual = std::fabs(e.R) / tau_tr;
         if (converged && residual <= 1e-10) {
@@ -404,21 +525,18 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
           uu = std::sqrt(Q_of(gg) / S);
           if (p_tr < 0.0) uu = std::max(uu, (phi_m * ck * K_3_ / S - 1.0) / a);
         }
+        if (defer2 != nullptr) {  // advance_batch runs the Newton iterations in lanes
+          *defer2 = TensionJob{phi, phi_m, a, visc, p_tr, tau_tr, g_max, gg, uu};
+          ReturnMap r;
+          r.deferred = true;
+          return r;
+        }
         bool step_ok = false;
-        for (int k = 1; k <= 8; ++k) {
+        for (int k = 1; k <= kTensionIterations; ++k) {
           ++iterations;
-          const double iu = 1.0 / uu;
-          const double Qp = 2.0 * gg * d2_rho_s_ + two_eta;
-          const double pp = Q_of(gg) * iu * iu;
-          const double iq = 1.0 / (1.0 + a * uu);
-          const double be = K_3_ * (phi - phi_m * iq), dbe = K_3_ * phi_m * a * iq * iq;
-          const double mq = mu_q(uu);
-          const double dmq = b_ == 0.0 ? 0.0 : (mu_2_ - mu_1_) * b_ / ((uu + b_) * (uu + b_));
-          const double h = pp - p_tr - Kdt * gg * be;
-          const double Rr = tau_tr - Gdt * gg - (mq + be) * pp - visc * gg * iu;
-          // residual exit with the tolerances of the nested solve (|R| <= 1e-14 tau_tr, pressure
-          // balance to 1e-15 of its terms)
-          if (std::fabs(Rr) <= 1e-14 * tau_tr && std::fabs(h) <= 1e-15 * (std::fabs(p_tr) + pp) && be >= 0.0) {
+          double pp, Rr;
+          const double st = tension_step(c, phi, phi_m, a, visc, p_tr, tau_tr, g_max, tol, gg, uu, pp, Rr);
+          if (st == 1.0) {
             fast = true;
             g = gg;
             u = uu;
@@ -426,17 +544,8 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
             residual = std::fabs(Rr) / tau_tr;
             break;
           }
-          const double hg = Qp * iu * iu - Kdt * be, hu = -2.0 * pp * iu - Kdt * gg * dbe;
-          const double Rg = -Gdt - (mq + be) * Qp * iu * iu - visc * iu;
-          const double Ru = -(dmq + dbe) * pp + 2.0 * (mq + be) * pp * iu + visc * gg * iu * iu;
-          const double det = hg * Ru - hu * Rg;
-          if (!(std::fabs(det) > 0.0)) break;
-          const double dg = (hu * Rr - h * Ru) / det;
-          const double du = (h * Rg - hg * Rr) / det;
-          gg += dg;
-          uu += du;
-          if (!(gg > 0.0 && gg <= g_max && uu > 0.0 && std::isfinite(uu))) break;
-          if (std::fabs(dg) <= tol * gg && std::fabs(du) <= tol * uu) {
+          if (st == 2.0) break;
+          if (st == 3.0) {
             step_ok = true;
             break;
           }
@@ -496,50 +605,71 @@ template <bool kDiagnostics>
 inline GranularUpdate GranularLaw::update_impl(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
                                         double dt, double phi, double eta_0) const {
   GranularUpdate out;
-  out.f_old = state.f;
+  Trial t;
+  if (!begin(state, D, W, dt, phi, eta_0, t, out)) return out;
+  finish<kDiagnostics>(state, t, return_map(state.f, phi, eta_0, dt, t.p_tr, t.tau_tr), dt, phi, eta_0, out);
+  return out;
+}
+
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline bool GranularLaw::begin(const GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
+                               double dt, double phi, double eta_0, Trial& t, GranularUpdate& out) const {
   // ---- input checks (never throw in the hot loop; report instead) ----
   if (!(dt > 0.0 && std::isfinite(dt)) || !(phi > 0.0 && phi < 1.0) || !(eta_0 > 0.0 && std::isfinite(eta_0)) ||
       !(state.f >= 0.0 && state.f <= 1.0) || !finite3(state.sigma) || !finite3(D) || !finite3(W)) {
+    out.f_old = state.f;
     out.finite = false;
     out.converged = false;
     out.message = "invalid input: need dt > 0, 0 < phi < 1, eta_0 > 0, f in [0, 1] and finite sigma, D, W";
-    return out;
+    return false;
   }
-  const double fn = state.f;
-  out.jammed = phi >= phi_j_;
-
   // ---- E16: elastic trial (D^p = 0), explicit Jaumann rotation with sigma_n ----
-  Eigen::Matrix3d s_tr;  // the trial stress, then its deviator
+  Eigen::Matrix3d& s_tr = t.s;  // the trial stress, then its deviator
   jaumann_trial(state.sigma, D, W, dt, G_, K_, s_tr);
-  const double p_tr = -s_tr.trace() / 3.0;
-  s_tr.diagonal().array() += p_tr;  // dev sigma_tr
-  const double tau_tr = std::sqrt(0.5 * s_tr.squaredNorm());
-  out.tau_trial = tau_tr;
-  out.p_trial = p_tr;
+  t.p_tr = -s_tr.trace() / 3.0;
+  s_tr.diagonal().array() += t.p_tr;  // dev sigma_tr
+  t.tau_tr = std::sqrt(0.5 * s_tr.squaredNorm());
 
   // ---- E24 ingredients that depend on phi only: f_m (E9), 1/eta_B (E8) ----
-  const double fm = rheology::f_m(steady_, phi);
-  double inv_eta_B = 0.0;
+  t.fm = rheology::f_m(steady_, phi);
+  t.inv_eta_B = 0.0;
   if (const double gap = phi_j_ - phi; gap > 0.0) {
     double lg = 0.0;
     bool have = false;
     for (std::size_t i = 0; i < steady_.eta_B_terms.size(); ++i) {
-      const rheology::EtaBTerm& t = steady_.eta_B_terms[i];
-      inv_eta_B += t.phi_i * pow_term(gap, t.alpha, eta_B_int_alpha_[i], lg, have);
+      const rheology::EtaBTerm& term = steady_.eta_B_terms[i];
+      t.inv_eta_B += term.phi_i * pow_term(gap, term.alpha, eta_B_int_alpha_[i], lg, have);
     }
   }
+  return true;
+}
+
+template <bool kDiagnostics>
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void GranularLaw::finish(GranularState& state, const Trial& t, ReturnMap r, double dt, double phi,
+                                double eta_0, GranularUpdate& out) const {
+  out.f_old = state.f;
+  const double fn = state.f;
+  out.jammed = phi >= phi_j_;
+  const double p_tr = t.p_tr, tau_tr = t.tau_tr, fm = t.fm, inv_eta_B = t.inv_eta_B;
+  const Eigen::Matrix3d& s_tr = t.s;
+  out.tau_trial = tau_tr;
+  out.p_trial = p_tr;
   // Linearly implicit E24 step with end-of-step tau_bar, gamma_dot^p: f = (f_n + dt H' f_m)/(1 + dt (H' + S')),
   // H' = K_0 gamma_dot^p (tau_bar/tau*)^{3/2}, S' = K_0 (gamma_dot^p + tau_bar/eta_B + xi_dot_eps); `stiff` = dt (H' + S').
-  auto f_next = [&](const ReturnMap& r, double& stiff) {
-    const double x = r.tau / tau_star_;
-    const double Hp = K_0_ * r.g * x * std::sqrt(x);
-    const double Sp = K_0_ * (r.g + r.tau * inv_eta_B + xi_dot_eps_);
+  auto f_next = [&](const ReturnMap& rr, double& stiff) {
+    const double x = rr.tau / tau_star_;
+    const double Hp = K_0_ * rr.g * x * std::sqrt(x);
+    const double Sp = K_0_ * (rr.g + rr.tau * inv_eta_B + xi_dot_eps_);
     stiff = dt * (Hp + Sp);
     return std::clamp((fn + dt * Hp * fm) / (1.0 + stiff), 0.0, 1.0);
   };
 
-  // ---- return map with f_n, then the structure update ----
-  ReturnMap r = return_map(fn, phi, eta_0, dt, p_tr, tau_tr);
+  // ---- the return map r with f_n (given), then the structure update ----
   double stiff = 0.0;
   double f_used = fn;
   double f_new = f_next(r, stiff);
@@ -658,12 +788,258 @@ inline GranularUpdate GranularLaw::update_impl(GranularState& state, const Eigen
   if (!finite3(sig) || !std::isfinite(f_new) || !std::isfinite(g) || !std::isfinite(p)) {
     out.finite = false;
     out.message = "non-finite result (state left unchanged)";
-    return out;
+    return;
   }
   if (!out.converged && out.message == nullptr) out.message = "return map did not converge within the iteration cap";
   for (int i = 0; i < 9; ++i) state.sigma.data()[i] = sig.data()[i];
   state.f = f_new;
-  return out;
+}
+
+namespace {
+
+/// Runs `jobs` iterative solves in N lanes: load(l, j) puts job j into lane l, step() advances every
+/// lane by one iteration (vectorised; idle lanes compute on their last values, which are finite),
+/// settle(l, j) books lane l's iteration and returns true when its job j is done; the lane then
+/// takes the next job.
+template <int N, class Load, class Step, class Settle>
+void run_lanes(int jobs, Load&& load, Step&& step, Settle&& settle) {
+  int lane_job[N];
+  int next = 0, active = 0;
+  for (int l = 0; l < N; ++l) {
+    lane_job[l] = next < jobs ? next++ : -1;
+    if (lane_job[l] >= 0) {
+      load(l, lane_job[l]);
+      ++active;
+    }
+  }
+  while (active > 0) {
+    step();
+    for (int l = 0; l < N; ++l) {
+      if (lane_job[l] < 0 || !settle(l, lane_job[l])) continue;
+      lane_job[l] = next < jobs ? next++ : -1;
+      if (lane_job[l] >= 0) load(l, lane_job[l]);
+      else --active;
+    }
+  }
+}
+
+}  // namespace
+
+void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* f, const Eigen::Matrix3d* L,
+                                const double* phi, double dt, GranularStep* step) const {
+  // Blocks of points: (1) trial and return map up to its Newton solve, handed back as a job (the
+  // f_1-only branch: F1Job; the p_tr <= 0 fast path: TensionJob); (2) the jobs' Newton iterations
+  // in kLanes lanes, a lane taking the next job when its own is done; (3) the rest of each update.
+  // Every point does the arithmetic of advance() in the same order (the same inline functions), so
+  // the results are those of advance(), bit for bit.
+  constexpr int kBlock = 128;
+  constexpr int N = kLanes;
+  const F1Consts c{K_ * dt, G_ * dt, 2.0 * eta_0_, d2_rho_s_, K_3_, mu_1_, mu_2_, b_};
+  const double tol = options_.rel_tol;
+  const int cap = options_.max_iter;
+  for (std::int64_t b0 = 0; b0 < n; b0 += kBlock) {
+    const int m = static_cast<int>(std::min<std::int64_t>(kBlock, n - b0));
+    Trial trial[kBlock];
+    ReturnMap rm[kBlock];
+    bool valid[kBlock];
+    F1Job f1[kBlock];
+    TensionJob tj[kBlock];
+    int f1_point[kBlock], tj_point[kBlock];
+    int n_f1 = 0, n_tj = 0;
+    // ---- (1) trials; the p_tr > 0 values at u_eq and the f_1 + f_3 closed form for every point
+    // in lanes (where unused too); then each return map up to its Newton solve ----
+    double s_f[kBlock], s_phi[kBlock], s_p_tr[kBlock], s_tau_tr[kBlock];
+    double c_g_lo[kBlock], c_p_lo[kBlock], c_R_lo[kBlock], c_be[kBlock], c_mq[kBlock], c_disc[kBlock];
+    double c_g[kBlock], c_p[kBlock], c_tau[kBlock], c_xi2[kBlock];
+    for (int i = 0; i < m; ++i) {
+      const std::int64_t q = b0 + i;
+      const double* Lq = L[q].data();
+      Eigen::Matrix3d D, W;
+      for (int jj = 0; jj < 3; ++jj) {
+        for (int ii = 0; ii < 3; ++ii) {
+          D(ii, jj) = 0.5 * (Lq[ii + 3 * jj] + Lq[jj + 3 * ii]);
+          W(ii, jj) = 0.5 * (Lq[ii + 3 * jj] - Lq[jj + 3 * ii]);
+        }
+      }
+      GranularState st;
+      for (int k = 0; k < 9; ++k) st.sigma.data()[k] = sigma[q].data()[k];
+      st.f = f[q];
+      GranularUpdate out;
+      valid[i] = begin(st, D, W, dt, phi[q], eta_0_, trial[i], out);
+      s_f[i] = f[q];
+      s_phi[i] = phi[q];
+      s_p_tr[i] = valid[i] ? trial[i].p_tr : 1.0;
+      s_tau_tr[i] = valid[i] ? trial[i].tau_tr : 1.0;
+    }
+    const double phi_j = phi_j_, phi_c = phi_c_, a_0 = a_0_, a_inf = a_inf_, eta_0 = eta_0_;
+#pragma omp simd
+    for (int i = 0; i < m; ++i) {
+      // as at the top of return_map
+      const double ph = s_phi[i];
+      const double phi_m = phi_j + (phi_c - phi_j) * s_f[i];  // E1
+      const double a = a_0 + (a_inf - a_0) * s_f[i];          // E2
+      const double visc = 2.5 * ph / a * eta_0;
+      const double u_eq_below = (phi_m - ph) / (a * ph);
+      const double u_eq = ph < phi_m ? u_eq_below : 0.0;
+      F1Value e;
+      double gc, pc, tc, xc;
+      compressive(c, ph, phi_m, a, visc, s_p_tr[i], s_tau_tr[i], u_eq, e, gc, pc, tc, xc);
+      c_g_lo[i] = e.g, c_p_lo[i] = e.p, c_R_lo[i] = e.R;
+      c_be[i] = e.be, c_mq[i] = e.mq, c_disc[i] = e.disc;
+      c_g[i] = gc, c_p[i] = pc, c_tau[i] = tc, c_xi2[i] = xc;
+    }
+    for (int i = 0; i < m; ++i) {
+      if (!valid[i]) continue;
+      const std::int64_t q = b0 + i;
+      const Compressive cm{F1Value{c_g_lo[i], c_p_lo[i], c_R_lo[i], c_be[i], c_mq[i], c_disc[i]}, c_g[i], c_p[i],
+                           c_tau[i], c_xi2[i]};
+      rm[i] = return_map(f[q], phi[q], eta_0_, dt, trial[i].p_tr, trial[i].tau_tr, &f1[n_f1], &tj[n_tj], &cm);
+      if (!rm[i].deferred) continue;
+      if (trial[i].p_tr > 0.0) f1_point[n_f1++] = i;
+      else tj_point[n_tj++] = i;
+    }
+    // ---- (2) lanes in SoA; results per job ----
+    struct Result {
+      double g, p, u, R;
+      int status;  // 1 converged, 2 failed, 3 (tension) step converged: check in (3)
+    };
+    Result res_f1[kBlock], res_tj[kBlock];
+    double x[N], lo[N], hi[N], lphi[N], lphi_m[N], la[N], lvisc[N], lp_tr[N], ltau_tr[N], lg_max[N];
+    double g[N], p[N], R[N], dR[N], status[N];
+    int it[N];
+    bool final_eval[N];
+    for (int l = 0; l < N; ++l) {  // finite values for lanes that never get a job
+      x[l] = lo[l] = hi[l] = lg_max[l] = g[l] = 1.0;
+      lphi[l] = 0.5, lphi_m[l] = 0.6, la[l] = 1.0, lvisc[l] = 1.0, lp_tr[l] = 1.0, ltau_tr[l] = 1.0;
+    }
+    auto load_common = [&](int l, double ph, double ph_m, double aa, double vi, double pt, double tt) {
+      lphi[l] = ph, lphi_m[l] = ph_m, la[l] = aa, lvisc[l] = vi, lp_tr[l] = pt, ltau_tr[l] = tt;
+      it[l] = 0;
+      final_eval[l] = false;
+    };
+    // (2a) f_1-only branch: Newton in u with bracket [lo, hi] (return_map's scalar loop, same steps)
+    run_lanes<N>(
+        n_f1,
+        [&](int l, int j) {
+          const F1Job& jb = f1[j];
+          load_common(l, jb.phi, jb.phi_m, jb.a, jb.visc, jb.p_tr, jb.tau_tr);
+          x[l] = jb.x, lo[l] = jb.lo, hi[l] = jb.hi;
+        },
+        [&] {
+#pragma omp simd
+          for (int l = 0; l < N; ++l) {
+            F1Value e;
+            f1_value(c, lphi[l], lphi_m[l], la[l], lvisc[l], lp_tr[l], ltau_tr[l], x[l], e);
+            g[l] = e.g;
+            p[l] = e.p;
+            R[l] = e.R;
+            dR[l] = f1_slope(c, lphi_m[l], la[l], lvisc[l], lp_tr[l], x[l], e);
+          }
+        },
+        [&](int l, int j) {
+          if (!final_eval[l]) {  // (st == 1: converged at the evaluated x, which f1_step leaves as it was)
+            const int st = f1_step(R[l], dR[l], ltau_tr[l], tol, x[l], lo[l], hi[l]);
+            ++it[l];
+            if (st == 2) {
+              final_eval[l] = true;  // evaluate at the new x, then stop
+              return false;
+            }
+            if (st == 0 && it[l] < cap) return false;
+            if (st == 0) {  // iteration cap
+              res_f1[j] = Result{0.0, 0.0, 0.0, 0.0, 2};
+              return true;
+            }
+          }
+          res_f1[j] = Result{g[l], p[l], x[l], R[l], 1};
+          return true;
+        });
+    // (2b) p_tr <= 0 fast path: Newton on (gamma_dot, u), at most kTensionIterations steps
+    run_lanes<N>(
+        n_tj,
+        [&](int l, int j) {
+          const TensionJob& jb = tj[j];
+          load_common(l, jb.phi, jb.phi_m, jb.a, jb.visc, jb.p_tr, jb.tau_tr);
+          lg_max[l] = jb.g_max, g[l] = jb.g, x[l] = jb.u;
+        },
+        [&] {
+#pragma omp simd
+          for (int l = 0; l < N; ++l)
+            status[l] = tension_step(c, lphi[l], lphi_m[l], la[l], lvisc[l], lp_tr[l], ltau_tr[l], lg_max[l], tol, g[l],
+                                     x[l], p[l], R[l]);
+        },
+        [&](int l, int j) {
+          ++it[l];
+          const int st = static_cast<int>(status[l]);
+          if (st == 0 && it[l] < kTensionIterations) return false;
+          res_tj[j] = Result{g[l], p[l], x[l], R[l], st == 0 ? 2 : st};
+          return true;
+        });
+    // ---- (3) the deferred return maps' ends (the scalar path for a job that failed) ----
+    for (int k = 0; k < n_f1; ++k) {
+      const int i = f1_point[k];
+      const std::int64_t q = b0 + i;
+      const Result& r = res_f1[k];
+      const F1Job& jb = f1[k];
+      const double residual = std::fabs(r.R) / jb.tau_tr;
+      if (r.status == 1 && residual <= 1e-10) {
+        ReturnMap& o = rm[i];
+        o = ReturnMap{};
+        o.g = r.g;
+        o.p = r.p;
+        o.residual = residual;
+        o.regime = GranularRegime::kShear;
+        // tau_bar from the friction side of E21: accurate even when G dt g >> tau_bar
+        o.tau = std::min(friction_of(c, jb.phi, jb.phi_m, jb.a, jb.visc, r.g, r.p, r.u), jb.tau_tr);
+      } else {
+        rm[i] = return_map(f[q], phi[q], eta_0_, dt, jb.p_tr, jb.tau_tr);  // the scalar path and its fallback
+      }
+    }
+    for (int k = 0; k < n_tj; ++k) {
+      const int i = tj_point[k];
+      const std::int64_t q = b0 + i;
+      const Result& r = res_tj[k];
+      const TensionJob& jb = tj[k];
+      bool fast = r.status == 1;
+      double gg = r.g, uu = r.u, pp = r.p, residual = std::fabs(r.R) / jb.tau_tr;
+      if (r.status == 3) {  // return_map's check after a converged step
+        pp = (gg * (gg * c.d2_rho_s + c.two_eta)) / (uu * uu);
+        const double be = K_3_ * (jb.phi - jb.phi_m / (1.0 + jb.a * uu));
+        const double h = pp - jb.p_tr - c.Kdt * gg * be;
+        const double Rr = jb.tau_tr - c.Gdt * gg - (mu_q(uu) + be) * pp - jb.visc * gg / uu;
+        residual = std::fabs(Rr) / jb.tau_tr;
+        fast = pp > 0.0 && be >= 0.0 && residual <= 1e-10 &&
+               std::fabs(h) <= 1e-12 * (std::fabs(jb.p_tr) + pp + c.Kdt * gg * be);
+      }
+      if (!fast) {
+        rm[i] = return_map(f[q], phi[q], eta_0_, dt, jb.p_tr, jb.tau_tr);  // the nested solve
+        continue;
+      }
+      ReturnMap& o = rm[i];
+      o = ReturnMap{};
+      o.g = gg;
+      o.p = pp;
+      o.residual = residual;
+      o.tau = std::min(friction_of(c, jb.phi, jb.phi_m, jb.a, jb.visc, gg, pp, uu), jb.tau_tr);
+      o.regime = pp > 0.0 ? GranularRegime::kShear : GranularRegime::kSeparated;
+      if (pp <= 0.0) o.xi1 = std::max(-jb.p_tr / c.Kdt - K_3_ * jb.phi * gg, 0.0);
+    }
+    for (int i = 0; i < m; ++i) {
+      const std::int64_t q = b0 + i;
+      if (!valid[i]) {
+        step[q] = GranularStep{GranularRegime::kElastic, false, 0.0};
+        continue;
+      }
+      GranularState st;
+      for (int k = 0; k < 9; ++k) st.sigma.data()[k] = sigma[q].data()[k];
+      st.f = f[q];
+      GranularUpdate out;
+      finish<false>(st, trial[i], rm[i], dt, phi[q], eta_0_, out);
+      step[q] = GranularStep{out.regime, out.ok(), out.gamma_dot_p};
+      if (!out.ok()) continue;
+      for (int k = 0; k < 9; ++k) sigma[q].data()[k] = st.sigma.data()[k];
+      f[q] = st.f;
+    }
+  }
 }
 
 std::string GranularLaw::describe(const GranularUpdate& u, const GranularState& before, const Eigen::Matrix3d& D,

@@ -98,6 +98,10 @@ struct GranularOptions {
   double stiff_structure = 0.5;  ///< kAuto threshold on dt (H' + S') [-] (staggering oscillates when >~ 1)
 };
 
+namespace granular_detail {
+struct Compressive;  ///< return_map's p_tr > 0 values computed ahead for a block of points (granular.cpp)
+}
+
 /// The law with its constants precomputed. Cheap to copy; thread-safe (update() is const).
 class GranularLaw {
  public:
@@ -119,6 +123,15 @@ class GranularLaw {
   /// not use. On failure call update() on the state before for the diagnosis.
   GranularStep advance(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W, double dt,
                        double phi) const;
+
+  /// advance() for n points at once (the MPM adapter's loop), with the same results bit for bit:
+  /// point i has stress sigma[i] and structure f[i], updated in place only when step[i].ok, velocity
+  /// gradient L[i] [1/s] (D and W are its symmetric and skew parts) and volume fraction phi[i].
+  /// The Newton iterations of the f_1 branch (most plastic points) run side by side in kLanes
+  /// lanes, vectorised across points, instead of one latency-bound chain per point.
+  void advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* f, const Eigen::Matrix3d* L, const double* phi,
+                     double dt, GranularStep* step) const;
+  static constexpr int kLanes = 8;
 
   /// Throws NumericalError with describe() unless u.ok().
   void require_ok(const GranularUpdate& u, const GranularState& before, const Eigen::Matrix3d& D,
@@ -145,13 +158,42 @@ class GranularLaw {
     double tau = 0.0, p = 0.0, g = 0.0, xi1 = 0.0, xi2 = 0.0, residual = 0.0;
     GranularRegime regime = GranularRegime::kElastic;
     bool converged = true;
+    bool deferred = false;  ///< the f_1 Newton solve was handed to the caller (F1Job)
     int iterations = 0;
   };
+  /// The E16 trial of a point and the E24 ingredients that depend on phi only.
+  struct Trial {
+    Eigen::Matrix3d s;  ///< deviator of the trial stress [Pa]
+    double p_tr, tau_tr, fm, inv_eta_B;
+  };
+  /// The f_1-only Newton solve in u = I_m (return_map) as data: per-point constants, start, bracket.
+  struct F1Job {
+    double phi, phi_m, a, visc, p_tr, tau_tr;
+    double x, lo, hi;
+  };
+  /// The p_tr <= 0 fast path's Newton solve on (gamma_dot, I_m) (return_map) as data.
+  struct TensionJob {
+    double phi, phi_m, a, visc, p_tr, tau_tr, g_max;
+    double g, u;  ///< start
+  };
+  static constexpr int kTensionIterations = 8;  ///< Newton steps of the fast path before the nested solve
   template <bool kDiagnostics>
   GranularUpdate update_impl(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W, double dt,
                              double phi, double eta_0) const;
-  /// E17–E23 at structure f for a given trial (p_tr, tau_tr): allocation-free, never throws.
-  ReturnMap return_map(double f, double phi, double eta_0, double dt, double p_tr, double tau_tr) const;
+  /// Input checks, E16 trial, f_m and 1/eta_B; false (out says why) for invalid input.
+  bool begin(const GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W, double dt, double phi,
+             double eta_0, Trial& t, GranularUpdate& out) const;
+  /// Structure update (E24, staggered or implicit) after the return map r at f_n, diagnostics and
+  /// the final stress; writes state when the result is finite.
+  template <bool kDiagnostics>
+  void finish(GranularState& state, const Trial& t, ReturnMap r, double dt, double phi, double eta_0,
+              GranularUpdate& out) const;
+  /// E17–E23 at structure f for a given trial (p_tr, tau_tr): allocation-free, never throws. With
+  /// `defer` (`defer2`), the f_1-only branch (the p_tr <= 0 fast path) returns deferred = true and
+  /// its Newton solve in *defer (*defer2).
+  ReturnMap return_map(double f, double phi, double eta_0, double dt, double p_tr, double tau_tr,
+                       F1Job* defer = nullptr, TensionJob* defer2 = nullptr,
+                       const granular_detail::Compressive* pre = nullptr) const;
 
   rheology::SteadyParams steady_;
   rheology::GranularParams granular_;
