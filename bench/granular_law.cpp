@@ -123,7 +123,7 @@ void run_hot(benchmark::State& bs, const std::vector<Case>& cases, const materia
   for (std::size_t k = 0; k < cases.size(); ++k) {
     sigma0[k] = cases[k].state.sigma;
     f0[k] = cases[k].state.f;
-    Lv[k] = cases[k].D + cases[k].W;
+    for (int i = 0; i < 9; ++i) Lv[k].data()[i] = cases[k].D.data()[i] + cases[k].W.data()[i];
     phi[k] = cases[k].phi;
   }
   for (auto _ : bs) {
@@ -134,7 +134,12 @@ void run_hot(benchmark::State& bs, const std::vector<Case>& cases, const materia
     } else {
       for (std::size_t k = 0; k < cases.size(); ++k) {
         material::GranularState s{sigma[k], f[k]};
-        const Eigen::Matrix3d D = 0.5 * (Lv[k] + Lv[k].transpose()), W = 0.5 * (Lv[k] - Lv[k].transpose());
+        Eigen::Matrix3d D, W;  // as in advance_batch
+        for (int j = 0; j < 3; ++j)
+          for (int i = 0; i < 3; ++i) {
+            D(i, j) = 0.5 * (Lv[k](i, j) + Lv[k](j, i));
+            W(i, j) = 0.5 * (Lv[k](i, j) - Lv[k](j, i));
+          }
         step[k] = L.advance(s, D, W, dt, phi[k]);
         sigma[k] = s.sigma;
         f[k] = s.f;
