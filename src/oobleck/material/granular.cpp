@@ -615,7 +615,8 @@ inline GranularUpdate GranularLaw::update_impl(GranularState& state, const Eigen
 [[gnu::always_inline]]
 #endif
 inline bool GranularLaw::begin(const GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
-                               double dt, double phi, double eta_0, Trial& t, GranularUpdate& out) const {
+                               double dt, double phi, double eta_0, Trial& t, GranularUpdate& out,
+                               bool with_eta_B) const {
   // ---- input checks (never throw in the hot loop; report instead) ----
   if (!(dt > 0.0 && std::isfinite(dt)) || !(phi > 0.0 && phi < 1.0) || !(eta_0 > 0.0 && std::isfinite(eta_0)) ||
       !(state.f >= 0.0 && state.f <= 1.0) || !finite3(state.sigma) || !finite3(D) || !finite3(W)) {
@@ -634,16 +635,21 @@ inline bool GranularLaw::begin(const GranularState& state, const Eigen::Matrix3d
 
   // ---- E24 ingredients that depend on phi only: f_m (E9), 1/eta_B (E8) ----
   t.fm = rheology::f_m(steady_, phi);
-  t.inv_eta_B = 0.0;
+  if (with_eta_B) t.inv_eta_B = inv_eta_B(phi);
+  return true;
+}
+
+double GranularLaw::inv_eta_B(double phi) const {
+  double r = 0.0;
   if (const double gap = phi_j_ - phi; gap > 0.0) {
     double lg = 0.0;
     bool have = false;
     for (std::size_t i = 0; i < steady_.eta_B_terms.size(); ++i) {
       const rheology::EtaBTerm& term = steady_.eta_B_terms[i];
-      t.inv_eta_B += term.phi_i * pow_term(gap, term.alpha, eta_B_int_alpha_[i], lg, have);
+      r += term.phi_i * pow_term(gap, term.alpha, eta_B_int_alpha_[i], lg, have);
     }
   }
-  return true;
+  return r;
 }
 
 template <bool kDiagnostics>
@@ -865,12 +871,15 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
       for (int k = 0; k < 9; ++k) st.sigma.data()[k] = sigma[q].data()[k];
       st.f = f[q];
       GranularUpdate out;
-      valid[i] = begin(st, D, W, dt, phi[q], eta_0_, trial[i], out);
+      valid[i] = begin(st, D, W, dt, phi[q], eta_0_, trial[i], out, false);
       s_f[i] = f[q];
       s_phi[i] = phi[q];
       s_p_tr[i] = valid[i] ? trial[i].p_tr : 1.0;
       s_tau_tr[i] = valid[i] ? trial[i].tau_tr : 1.0;
     }
+    // E8 on its own: pow() for a non-integer alpha (log and exp of libm) in a loop of independent
+    // calls, which the processor overlaps (inside begin() they serialised with the trial)
+    for (int i = 0; i < m; ++i) trial[i].inv_eta_B = valid[i] ? inv_eta_B(phi[b0 + i]) : 0.0;
     const double phi_j = phi_j_, phi_c = phi_c_, a_0 = a_0_, a_inf = a_inf_, eta_0 = eta_0_;
 #pragma omp simd
     for (int i = 0; i < m; ++i) {
