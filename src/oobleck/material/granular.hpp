@@ -127,8 +127,9 @@ class GranularLaw {
   /// advance() for n points at once (the MPM adapter's loop), with the same results bit for bit:
   /// point i has stress sigma[i] and structure f[i], updated in place only when step[i].ok, velocity
   /// gradient L[i] [1/s] (D and W are its symmetric and skew parts) and volume fraction phi[i].
-  /// The Newton iterations of the f_1 branch (most plastic points) run side by side in kLanes
-  /// lanes, vectorised across points, instead of one latency-bound chain per point.
+  /// The Newton solves (the f_1-only branch, the p_tr <= 0 fast path) run side by side in kLanes
+  /// lanes, vectorised across points, and so does the f_1 + f_3 closed form, instead of one
+  /// latency-bound chain per point (docs/granular.md). n may be any size (blocks of 128 inside).
   void advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* f, const Eigen::Matrix3d* L, const double* phi,
                      double dt, GranularStep* step) const;
   static constexpr int kLanes = 8;
@@ -158,7 +159,7 @@ class GranularLaw {
     double tau = 0.0, p = 0.0, g = 0.0, xi1 = 0.0, xi2 = 0.0, residual = 0.0;
     GranularRegime regime = GranularRegime::kElastic;
     bool converged = true;
-    bool deferred = false;  ///< the f_1 Newton solve was handed to the caller (F1Job)
+    bool deferred = false;  ///< the Newton solve was handed to the caller (F1Job or TensionJob)
     int iterations = 0;
   };
   /// The E16 trial of a point and the E24 ingredients that depend on phi only.
