@@ -427,8 +427,11 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
     } else {
       // Fast path, parametrised by u = I_m >= u_eq (beta >= 0, xi_dot_2 = 0): f1_value, R(u)
       // decreasing in u (docs/granular.md). Its value at u_eq decides between f_1 + f_3 and f_1.
+      // (compressive(): that value and the f_1 + f_3 closed form below; advance_batch passes both
+      // in `pre`, computed for a block of points in lanes)
       Compressive cm_own;
-      if (pre == nullptr) compressive(c, phi, phi_m, a, visc, p_tr, tau_tr, u_eq, cm_own.e_lo, cm_own.g, cm_own.p, cm_own.tau, cm_own.xi2);
+      if (pre == nullptr)
+        compressive(c, phi, phi_m, a, visc, p_tr, tau_tr, u_eq, cm_own.e_lo, cm_own.g, cm_own.p, cm_own.tau, cm_own.xi2);
       const Compressive& cm = pre != nullptr ? *pre : cm_own;
       const F1Value& e_lo = cm.e_lo;
       if (e_lo.R <= 0.0 && u_eq > 0.0) {
