@@ -138,6 +138,17 @@ using granular_detail::F1Consts;
 using granular_detail::F1Value;
 namespace {
 
+/// E20 mu_q(I_m) = mu_1 + (mu_2 - mu_1) I_m/(I_m + b) (GranularLaw::mu_q, mu_2 for b = 0) and its
+/// derivative, without branches (both sides computed) so that the lane loops vectorise.
+inline double f1_mu_q(const F1Consts& c, double uu) {
+  const double mq_b = c.mu_1 + (c.mu_2 - c.mu_1) * uu / (uu + c.b);
+  return c.b == 0.0 ? c.mu_2 : mq_b;
+}
+inline double f1_dmu_q(const F1Consts& c, double uu) {
+  const double dmq_b = (c.mu_2 - c.mu_1) * c.b / ((uu + c.b) * (uu + c.b));
+  return c.b == 0.0 ? 0.0 : dmq_b;
+}
+
 /// For given u the pressure balance p = p_tr + K dt beta(u) gamma_dot with p = Q(gamma_dot)/u^2 (E18,
 /// E19) is a quadratic in gamma_dot with one positive root; R(u) = tau_tr - G dt gamma_dot - mu_p p
 /// is the E21 residual, mu_p from E20.
@@ -154,8 +165,7 @@ inline void f1_value(const F1Consts& c, double phi, double phi_m, double a, doub
   const double g_plus = 2.0 * C2 / (B2 + e.disc), g_minus = (e.disc - B2) / (2.0 * A2);
   e.g = B2 >= 0.0 ? g_plus : g_minus;
   e.p = p_tr + c.Kdt * e.be * e.g;
-  const double mq_b = c.mu_1 + (c.mu_2 - c.mu_1) * uu / (uu + c.b);  // E20 mu_q
-  e.mq = c.b == 0.0 ? c.mu_2 : mq_b;
+  e.mq = f1_mu_q(c, uu);  // E20 mu_q
   // viscous friction term of E20 times p: (5/2) phi/a * I_v/I_m * p = visc * g/u
   const double g_over_u = e.g / uu;
   const double gv = uu > 0.0 ? g_over_u : 0.0;
@@ -175,8 +185,7 @@ inline double f1_slope(const F1Consts& c, double phi_m, double a, double visc, d
   const double dg_d = (dC2 - dB2 * e.g) / e.disc;
   const double dg = e.disc > 0.0 ? dg_d : 0.0;
   const double dp = c.Kdt * (dbe * e.g + be * dg);
-  const double dmq_b = (c.mu_2 - c.mu_1) * c.b / ((uu + c.b) * (uu + c.b));
-  const double dmq = c.b == 0.0 ? 0.0 : dmq_b;
+  const double dmq = f1_dmu_q(c, uu);
   const double dgv_u = dg / uu - e.g / (uu * uu);
   const double dgv = uu > 0.0 ? dgv_u : p_tr / c.two_eta;  // g ~ p_tr u^2/(2 eta_0) as u -> 0
   return -c.Gdt * dg - (dmq + dbe) * e.p - (e.mq + be) * dp - visc * dgv;
@@ -205,8 +214,7 @@ inline int f1_step(double R, double dR, double tau_tr, double tol, double& x, do
 inline void compressive(const F1Consts& c, double phi, double phi_m, double a, double visc, double p_tr,
                         double tau_tr, double u_eq, F1Value& e_lo, double& g, double& p, double& tau, double& xi2) {
   f1_value(c, phi, phi_m, a, visc, p_tr, tau_tr, u_eq, e_lo);
-  const double mq_b = c.mu_1 + (c.mu_2 - c.mu_1) * u_eq / (u_eq + c.b);
-  const double mq = c.b == 0.0 ? c.mu_2 : mq_b;
+  const double mq = f1_mu_q(c, u_eq);
   const double u2 = u_eq * u_eq;
   const double A = mq * c.d2_rho_s;
   const double B = c.Gdt * u2 + mq * c.two_eta + visc * u_eq;
@@ -218,11 +226,6 @@ inline void compressive(const F1Consts& c, double phi, double phi_m, double a, d
   xi2 = std::min((p - p_tr) / c.Kdt, 0.0);  // E23: xi_dot_2 <= 0
 }
 
-/// E20 mu_q(I_m) (GranularLaw::mu_q) with the constants of c.
-inline double f1_mu_q(const F1Consts& c, double uu) {
-  if (c.b == 0.0) return c.mu_2;
-  return c.mu_1 + (c.mu_2 - c.mu_1) * uu / (uu + c.b);
-}
 
 /// Friction side of E21 at (gamma_dot, p, I_m): max((mu_p + beta) p, 0), with E20 written as
 /// mu_p p = mu_q(I_m) p + (5/2)(phi/a) eta_0 gamma_dot/I_m; beta from E18.
@@ -249,10 +252,7 @@ inline double tension_step(const F1Consts& c, double phi, double phi_m, double a
   const double pp = (gg * (gg * c.d2_rho_s + c.two_eta)) * iu * iu;
   const double iq = 1.0 / (1.0 + a * uu);
   const double be = c.K_3 * (phi - phi_m * iq), dbe = c.K_3 * phi_m * a * iq * iq;
-  const double mq_b = c.mu_1 + (c.mu_2 - c.mu_1) * uu / (uu + c.b);
-  const double mq = c.b == 0.0 ? c.mu_2 : mq_b;
-  const double dmq_b = (c.mu_2 - c.mu_1) * c.b / ((uu + c.b) * (uu + c.b));
-  const double dmq = c.b == 0.0 ? 0.0 : dmq_b;
+  const double mq = f1_mu_q(c, uu), dmq = f1_dmu_q(c, uu);
   const double h = pp - p_tr - c.Kdt * gg * be;
   const double Rr = tau_tr - c.Gdt * gg - (mq + be) * pp - visc * gg * iu;
   // residual exit with the tolerances of the nested solve (|R| <= 1e-14 tau_tr, pressure balance to
@@ -278,6 +278,18 @@ inline double tension_step(const F1Consts& c, double phi, double phi_m, double a
   const double st = small ? 3.0 : 0.0;
   const double st2 = (singular | !in_range) ? 2.0 : st;
   return fast ? 1.0 : st2;
+}
+
+/// The p_tr <= 0 fast path's acceptance of a converged Newton step at (gg, uu): the pressure pp and
+/// the relative E21 residual res there, and whether both residuals are small (else the nested solve).
+inline bool tension_accept(const F1Consts& c, double phi, double phi_m, double a, double visc, double p_tr,
+                           double tau_tr, double gg, double uu, double& pp, double& res) {
+  pp = (gg * (gg * c.d2_rho_s + c.two_eta)) / (uu * uu);
+  const double be = c.K_3 * (phi - phi_m / (1.0 + a * uu));
+  const double h = pp - p_tr - c.Kdt * gg * be;
+  const double Rr = tau_tr - c.Gdt * gg - (f1_mu_q(c, uu) + be) * pp - visc * gg / uu;
+  res = std::fabs(Rr) / tau_tr;
+  return pp > 0.0 && be >= 0.0 && res <= 1e-10 && std::fabs(h) <= 1e-12 * (std::fabs(p_tr) + pp + c.Kdt * gg * be);
 }
 
 }  // namespace
@@ -553,13 +565,9 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
             break;
           }
         }
+        double pp = 0.0, res = 0.0;
         if (step_ok && !fast) {
-          const double pp = Q_of(gg) / (uu * uu);
-          const double be = beta_of(uu);
-          const double h = pp - p_tr - Kdt * gg * be;
-          const double Rr = tau_tr - Gdt * gg - (mu_q(uu) + be) * pp - visc * gg / uu;
-          const double res = std::fabs(Rr) / tau_tr;
-          if (pp > 0.0 && be >= 0.0 && res <= 1e-10 && std::fabs(h) <= 1e-12 * (std::fabs(p_tr) + pp + Kdt * gg * be)) {
+          if (tension_accept(c, phi, phi_m, a, visc, p_tr, tau_tr, gg, uu, pp, res)) {
             fast = true;
             g = gg;
             u = uu;
@@ -1013,15 +1021,8 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
       const TensionJob& jb = tj[k];
       bool fast = r.status == 1;
       double gg = r.g, uu = r.u, pp = r.p, residual = std::fabs(r.R) / jb.tau_tr;
-      if (r.status == 3) {  // return_map's check after a converged step
-        pp = (gg * (gg * c.d2_rho_s + c.two_eta)) / (uu * uu);
-        const double be = K_3_ * (jb.phi - jb.phi_m / (1.0 + jb.a * uu));
-        const double h = pp - jb.p_tr - c.Kdt * gg * be;
-        const double Rr = jb.tau_tr - c.Gdt * gg - (mu_q(uu) + be) * pp - jb.visc * gg / uu;
-        residual = std::fabs(Rr) / jb.tau_tr;
-        fast = pp > 0.0 && be >= 0.0 && residual <= 1e-10 &&
-               std::fabs(h) <= 1e-12 * (std::fabs(jb.p_tr) + pp + c.Kdt * gg * be);
-      }
+      if (r.status == 3)  // return_map's check after a converged step
+        fast = tension_accept(c, jb.phi, jb.phi_m, jb.a, jb.visc, jb.p_tr, jb.tau_tr, gg, uu, pp, residual);
       if (!fast) {
         rm[i] = return_map(f[q], phi[q], eta_0_, dt, jb.p_tr, jb.tau_tr);  // the nested solve
         continue;
