@@ -79,40 +79,74 @@ inline double pow_term(double x, double alpha, int int_alpha, double& log_x, boo
   return std::exp(alpha * log_x);
 }
 
-/// m.allFinite() without branches: x * 0 is NaN exactly when x is infinite or NaN.
-inline bool finite3(const Eigen::Matrix3d& m) {
-  const double* x = m.data();
-  double z = 0.0;
-  for (int i = 0; i < 9; ++i) z += x[i] * 0.0;
-  return z == 0.0;
+/// A 3x3 tensor as nine numbers, column-major (Eigen's order), for the functions below that also
+/// run in lanes across points: GCC vectorises an `omp simd` loop that passes these by reference,
+/// but not one that passes pointers to local arrays.
+struct T9 {
+  double v[9];
+};
+inline T9 to9(const Eigen::Matrix3d& m) {
+  T9 t;
+  for (int k = 0; k < 9; ++k) t.v[k] = m.data()[k];
+  return t;
 }
 
-/// E16 trial sig + dt (2 G D + W sig - sig W) + dt (K - 2G/3) tr(D) 1, written out so that it inlines.
-/// Every sum is formed in the order of the Eigen 3.4 expression it replaces (the SSE2 lazy product
-/// sums rows 0-1 as (k0 + k1) + k2 and row 2 as k0 + (k1 + k2); the trace is d00 + (d11 + d22)), so
-/// the result is the same bit for bit. (For W = skew(L), with its zero diagonal, the order is moot.)
+/// All nine entries finite, without branches: x * 0 is NaN exactly when x is infinite or NaN.
+inline bool finite9(const T9& x) {
+  double z = 0.0;
+  for (int i = 0; i < 9; ++i) z += x.v[i] * 0.0;
+  return z == 0.0;
+}
+inline bool finite3(const Eigen::Matrix3d& m) { return finite9(to9(m)); }
+
+/// E16 trial sig + dt (2 G D + W sig - sig W) + dt (K - 2G/3) tr(D) 1, written out so that it
+/// inlines and vectorises across points. Every sum is formed in the order of the Eigen 3.4
+/// expression it replaces (the SSE2 lazy product sums rows 0-1 as (k0 + k1) + k2 and row 2 as
+/// k0 + (k1 + k2); the trace is d00 + (d11 + d22)), so the result is the same bit for bit. (For
+/// W = skew(L), with its zero diagonal, the order is moot.)
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void jaumann_trial(const Eigen::Matrix3d& S, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W, double dt,
-                          double G, double K, Eigen::Matrix3d& r) {
+inline T9 jaumann_trial(const T9& S, const T9& D, const T9& W, double dt, double G, double K) {
   const double two_G = 2.0 * G;
+  auto at = [](const T9& m, int i, int j) { return m.v[i + 3 * j]; };
+  T9 r;
   for (int j = 0; j < 3; ++j) {
     for (int i = 0; i < 3; ++i) {
       double ws, sw;
       if (i < 2) {
-        ws = (W(i, 0) * S(0, j) + W(i, 1) * S(1, j)) + W(i, 2) * S(2, j);
-        sw = (S(i, 0) * W(0, j) + S(i, 1) * W(1, j)) + S(i, 2) * W(2, j);
+        ws = (at(W, i, 0) * at(S, 0, j) + at(W, i, 1) * at(S, 1, j)) + at(W, i, 2) * at(S, 2, j);
+        sw = (at(S, i, 0) * at(W, 0, j) + at(S, i, 1) * at(W, 1, j)) + at(S, i, 2) * at(W, 2, j);
       } else {
-        ws = W(i, 0) * S(0, j) + (W(i, 1) * S(1, j) + W(i, 2) * S(2, j));
-        sw = S(i, 0) * W(0, j) + (S(i, 1) * W(1, j) + S(i, 2) * W(2, j));
+        ws = at(W, i, 0) * at(S, 0, j) + (at(W, i, 1) * at(S, 1, j) + at(W, i, 2) * at(S, 2, j));
+        sw = at(S, i, 0) * at(W, 0, j) + (at(S, i, 1) * at(W, 1, j) + at(S, i, 2) * at(W, 2, j));
       }
-      r(i, j) = S(i, j) + dt * ((two_G * D(i, j) + ws) - sw);
+      r.v[i + 3 * j] = at(S, i, j) + dt * ((two_G * at(D, i, j) + ws) - sw);
     }
   }
-  const double trD = D(0, 0) + (D(1, 1) + D(2, 2));
+  const double trD = D.v[0] + (D.v[4] + D.v[8]);
   const double vol = dt * (K - two_G / 3.0) * trD;
-  for (int i = 0; i < 3; ++i) r(i, i) += vol;
+  for (int i = 0; i < 3; ++i) r.v[4 * i] += vol;
+  return r;
+}
+
+/// The E16 trial of one point: returns the deviator of the trial stress and sets p_tr = -tr/3 and
+/// tau_tr = sqrt(|dev|^2/2). The sums in the order of Eigen's trace() (d00 + (d11 + d22)) and
+/// squaredNorm() (SSE2 pairs summed as two lanes, then the ninth entry), which GCC's Eigen 3.4 uses
+/// for a Matrix3d with or without AVX (with -ffp-contract=off): bit for bit as before.
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline T9 elastic_trial(const T9& S, const T9& D, const T9& W, double dt, double G, double K, double& p_tr,
+                        double& tau_tr) {
+  T9 s = jaumann_trial(S, D, W, dt, G, K);
+  p_tr = -(s.v[0] + (s.v[4] + s.v[8])) / 3.0;
+  for (int i = 0; i < 3; ++i) s.v[4 * i] += p_tr;  // dev sigma_tr
+  double q[9];
+  for (int k = 0; k < 9; ++k) q[k] = s.v[k] * s.v[k];
+  const double sq = (((q[0] + q[2]) + (q[4] + q[6])) + ((q[1] + q[3]) + (q[5] + q[7]))) + q[8];
+  tau_tr = std::sqrt(0.5 * sq);
+  return s;
 }
 
 // ---- The f_1-only branch of the return map in u = I_m (docs/granular.md), shared by the scalar
@@ -626,8 +660,7 @@ inline GranularUpdate GranularLaw::update_impl(GranularState& state, const Eigen
 [[gnu::always_inline]]
 #endif
 inline bool GranularLaw::begin(const GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
-                               double dt, double phi, double eta_0, Trial& t, GranularUpdate& out,
-                               bool with_eta_B) const {
+                               double dt, double phi, double eta_0, Trial& t, GranularUpdate& out) const {
   // ---- input checks (never throw in the hot loop; report instead) ----
   if (!(dt > 0.0 && std::isfinite(dt)) || !(phi > 0.0 && phi < 1.0) || !(eta_0 > 0.0 && std::isfinite(eta_0)) ||
       !(state.f >= 0.0 && state.f <= 1.0) || !finite3(state.sigma) || !finite3(D) || !finite3(W)) {
@@ -638,15 +671,12 @@ inline bool GranularLaw::begin(const GranularState& state, const Eigen::Matrix3d
     return false;
   }
   // ---- E16: elastic trial (D^p = 0), explicit Jaumann rotation with sigma_n ----
-  Eigen::Matrix3d& s_tr = t.s;  // the trial stress, then its deviator
-  jaumann_trial(state.sigma, D, W, dt, G_, K_, s_tr);
-  t.p_tr = -s_tr.trace() / 3.0;
-  s_tr.diagonal().array() += t.p_tr;  // dev sigma_tr
-  t.tau_tr = std::sqrt(0.5 * s_tr.squaredNorm());
+  const T9 s = elastic_trial(to9(state.sigma), to9(D), to9(W), dt, G_, K_, t.p_tr, t.tau_tr);
+  for (int k = 0; k < 9; ++k) t.s.data()[k] = s.v[k];
 
   // ---- E24 ingredients that depend on phi only: f_m (E9), 1/eta_B (E8) ----
   t.fm = rheology::f_m(steady_, phi);
-  if (with_eta_B) t.inv_eta_B = inv_eta_B(phi);
+  t.inv_eta_B = inv_eta_B(phi);
   return true;
 }
 
@@ -856,7 +886,6 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
   const int cap = options_.max_iter;
   for (std::int64_t b0 = 0; b0 < n; b0 += kBlock) {
     const int m = static_cast<int>(std::min<std::int64_t>(kBlock, n - b0));
-    Trial trial[kBlock];
     ReturnMap rm[kBlock];
     bool valid[kBlock];
     F1Job f1[kBlock];
@@ -868,29 +897,43 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
     double s_f[kBlock], s_phi[kBlock], s_p_tr[kBlock], s_tau_tr[kBlock];
     double c_g_lo[kBlock], c_p_lo[kBlock], c_R_lo[kBlock], c_be[kBlock], c_mq[kBlock], c_disc[kBlock];
     double c_g[kBlock], c_p[kBlock], c_tau[kBlock], c_xi2[kBlock];
+    // The E16 trials (begin(): checks, trial, f_m) in lanes: sigma and L gathered component-major
+    double bS[9][kBlock], bL[9][kBlock], t_s[9][kBlock], t_fm[kBlock], t_inv_eta_B[kBlock];
     for (int i = 0; i < m; ++i) {
-      const std::int64_t q = b0 + i;
-      const double* Lq = L[q].data();
-      Eigen::Matrix3d D, W;
+      for (int k = 0; k < 9; ++k) {
+        bS[k][i] = sigma[b0 + i].data()[k];
+        bL[k][i] = L[b0 + i].data()[k];
+      }
+    }
+    const bool dt_ok = dt > 0.0 && std::isfinite(dt) && eta_0_ > 0.0 && std::isfinite(eta_0_);
+    const double G = G_, K = K_;
+#pragma omp simd
+    for (int i = 0; i < m; ++i) {
+      T9 Sx, Dx, Wx;
+      double pt, tt;
+      for (int k = 0; k < 9; ++k) Sx.v[k] = bS[k][i];
       for (int jj = 0; jj < 3; ++jj) {
         for (int ii = 0; ii < 3; ++ii) {
-          D(ii, jj) = 0.5 * (Lq[ii + 3 * jj] + Lq[jj + 3 * ii]);
-          W(ii, jj) = 0.5 * (Lq[ii + 3 * jj] - Lq[jj + 3 * ii]);
+          Dx.v[ii + 3 * jj] = 0.5 * (bL[ii + 3 * jj][i] + bL[jj + 3 * ii][i]);
+          Wx.v[ii + 3 * jj] = 0.5 * (bL[ii + 3 * jj][i] - bL[jj + 3 * ii][i]);
         }
       }
-      GranularState st;
-      for (int k = 0; k < 9; ++k) st.sigma.data()[k] = sigma[q].data()[k];
-      st.f = f[q];
-      GranularUpdate out;
-      valid[i] = begin(st, D, W, dt, phi[q], eta_0_, trial[i], out, false);
-      s_f[i] = f[q];
-      s_phi[i] = phi[q];
-      s_p_tr[i] = valid[i] ? trial[i].p_tr : 1.0;
-      s_tau_tr[i] = valid[i] ? trial[i].tau_tr : 1.0;
+      const T9 sx = elastic_trial(Sx, Dx, Wx, dt, G, K, pt, tt);
+      const double ff = f[b0 + i], ph = phi[b0 + i];
+      // begin()'s input checks
+      const bool ok = dt_ok & (ph > 0.0) & (ph < 1.0) & (ff >= 0.0) & (ff <= 1.0) & finite9(Sx) & finite9(Dx) &
+                      finite9(Wx);
+      for (int k = 0; k < 9; ++k) t_s[k][i] = sx.v[k];
+      valid[i] = ok;
+      s_f[i] = ff;
+      s_phi[i] = ph;
+      s_p_tr[i] = ok ? pt : 1.0;
+      s_tau_tr[i] = ok ? tt : 1.0;
+      t_fm[i] = rheology::f_m(steady_, ph);
     }
     // E8 on its own: pow() for a non-integer alpha (log and exp of libm) in a loop of independent
     // calls, which the processor overlaps (inside begin() they serialised with the trial)
-    for (int i = 0; i < m; ++i) trial[i].inv_eta_B = valid[i] ? inv_eta_B(phi[b0 + i]) : 0.0;
+    for (int i = 0; i < m; ++i) t_inv_eta_B[i] = valid[i] ? inv_eta_B(phi[b0 + i]) : 0.0;
     const double phi_j = phi_j_, phi_c = phi_c_, a_0 = a_0_, a_inf = a_inf_, eta_0 = eta_0_;
 #pragma omp simd
     for (int i = 0; i < m; ++i) {
@@ -913,9 +956,9 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
       const std::int64_t q = b0 + i;
       const Compressive cm{F1Value{c_g_lo[i], c_p_lo[i], c_R_lo[i], c_be[i], c_mq[i], c_disc[i]}, c_g[i], c_p[i],
                            c_tau[i], c_xi2[i]};
-      rm[i] = return_map(f[q], phi[q], eta_0_, dt, trial[i].p_tr, trial[i].tau_tr, &f1[n_f1], &tj[n_tj], &cm);
+      rm[i] = return_map(f[q], phi[q], eta_0_, dt, s_p_tr[i], s_tau_tr[i], &f1[n_f1], &tj[n_tj], &cm);
       if (!rm[i].deferred) continue;
-      if (trial[i].p_tr > 0.0) f1_point[n_f1++] = i;
+      if (s_p_tr[i] > 0.0) f1_point[n_f1++] = i;
       else tj_point[n_tj++] = i;
     }
     // ---- (2) lanes in SoA; results per job ----
@@ -1045,8 +1088,14 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
       GranularState st;
       for (int k = 0; k < 9; ++k) st.sigma.data()[k] = sigma[q].data()[k];
       st.f = f[q];
+      Trial t;
+      for (int k = 0; k < 9; ++k) t.s.data()[k] = t_s[k][i];
+      t.p_tr = s_p_tr[i];
+      t.tau_tr = s_tau_tr[i];
+      t.fm = t_fm[i];
+      t.inv_eta_B = t_inv_eta_B[i];
       GranularUpdate out;
-      finish<false>(st, trial[i], rm[i], dt, phi[q], eta_0_, out);
+      finish<false>(st, t, rm[i], dt, phi[q], eta_0_, out);
       step[q] = GranularStep{out.regime, out.ok(), out.gamma_dot_p};
       if (!out.ok()) continue;
       for (int k = 0; k < 9; ++k) sigma[q].data()[k] = st.sigma.data()[k];

@@ -183,7 +183,7 @@ class GranularLaw {
                              double phi, double eta_0) const;
   /// Input checks, E16 trial, f_m and 1/eta_B; false (out says why) for invalid input.
   bool begin(const GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W, double dt, double phi,
-             double eta_0, Trial& t, GranularUpdate& out, bool with_eta_B = true) const;
+             double eta_0, Trial& t, GranularUpdate& out) const;
   /// 1/eta_B(phi) of E8 (0 for phi >= phi_j) [1/(Pa s)].
   double inv_eta_B(double phi) const;
   /// Structure update (E24, staggered or implicit) after the return map r at f_n, diagnostics and

@@ -9,11 +9,12 @@ inline double phi_star(const SteadyParams& p) { return p.phi_j + (p.phi_c - p.ph
 
 /// E9: f_m(phi) = 1 for phi <= phi_c; (phi - phi_j)/(phi_c - phi_j) for phi_c < phi <= phi*;
 /// (phi* - phi_j)/(phi_c - phi_j) for phi > phi*.
+/// (Both branches computed and selected, so that a loop over points that calls it vectorises.)
 inline double f_m(const SteadyParams& p, double phi) {
-  if (phi <= p.phi_c) return 1.0;
   const double ps = phi_star(p);
   const double phi_eff = phi <= ps ? phi : ps;
-  return (phi_eff - p.phi_j) / (p.phi_c - p.phi_j);
+  const double above = (phi_eff - p.phi_j) / (p.phi_c - p.phi_j);
+  return phi <= p.phi_c ? 1.0 : above;
 }
 
 }  // namespace oobleck::rheology
