@@ -171,6 +171,31 @@ TEST(Shape, ClosedFormValuesAndApicInertia) {
   }
 }
 
+// APIC's D_p = ∑_i N_ip (x_i − x_p)(x_i − x_p)ᵀ (diagonal for tensor-product kernels): the cache
+// stores the constant h²/4 (quadratic) or h²/3 (cubic) B-spline value, uGIMP's computed per point.
+// Check the stored 1/D_p against the moment summed from the cached weights and offsets, at points
+// all over a 2D grid with a periodic axis (seam) and walls.
+template <class Kernel>
+void check_inertia_is_the_second_moment(const Kernel& kernel) {
+  const Grid<2> g(Vec<2>(-0.3, 0.1), 0.25, {6, 5}, {true, false});
+  std::vector<Vec<2>> x;
+  for (int k = 0; k < 157; ++k)
+    x.emplace_back(-0.3 + 1.5 * ((k * 0.6180339887) - std::floor(k * 0.6180339887)),
+                   0.1 + 1.25 * ((k * 0.7548776662) - std::floor(k * 0.7548776662)));
+  ShapeCache<2> c;
+  ASSERT_EQ(compute_shape_cache(g, kernel, x, c), 0);
+  for (std::int64_t p = 0; p < static_cast<std::int64_t>(x.size()); ++p) {
+    Vec<2> m2 = Vec<2>::Zero();
+    for (int k = 0; k < c.K; ++k) m2 += c.weight(p, k) * c.offset(p, k).cwiseProduct(c.offset(p, k));
+    for (int a = 0; a < 2; ++a) EXPECT_NEAR(m2[a] * c.inv_D[p][a], 1.0, 1e-13) << "point " << p << " axis " << a;
+  }
+}
+TEST(Shape, ApicInertiaIsTheSecondMomentOfTheWeights) {
+  check_inertia_is_the_second_moment(QuadraticBSplineKernel{});
+  check_inertia_is_the_second_moment(CubicBSplineKernel{});
+  check_inertia_is_the_second_moment(UGimpKernel{0.25});
+}
+
 TEST(Shape, PointsFarOutsideAreReported) {
   const Grid<2> g(Vec<2>(0, 0), 1.0, {4, 4});
   ShapeCache<2> c;
