@@ -12,6 +12,8 @@
 #include "oobleck/core/error.hpp"
 #include "oobleck/io/checkpoint.hpp"
 #include "oobleck/io/csv.hpp"
+#include "oobleck/mpm/laws.hpp"
+#include "oobleck/mpm/solver.hpp"
 #include "oobleck/run/finite_check.hpp"
 #include "oobleck/run/runner.hpp"
 #include "oobleck/scene/config.hpp"
@@ -138,6 +140,38 @@ TEST(RunScenes, InvalidScenesAreRefusedBeforeAnyOutput) {
     EXPECT_NE(r.output.find("bad.toml"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(d / "out")) << c.message;
   }
+}
+
+// The guards fused into the step (G2P checks the new x, v, V; the elastic and fluid laws their new
+// stress) answer what the runner's full scan would: the runner scans a body only when one of them
+// did not check or found something.
+TEST(RunScenes, FusedNonFiniteGuardsAgreeWithTheFullScan) {
+  using namespace mpm;
+  const Grid<2> grid(Vec<2>(0.0, 0.0), 0.1, {10, 10});
+  SolverOptions<PlaneStrain> opt;
+  opt.dt_s = 1e-4;
+  opt.threads = 2;
+  material::LinearElasticParams ep;
+  ep.youngs_modulus_Pa = 1e5;
+  ep.poisson_ratio = 0.3;
+  Solver<PlaneStrain> s(grid, opt);
+  auto& b = s.add_body("block");
+  b.set_law(std::make_unique<LinearElasticLaw<PlaneStrain>>(ep));
+  for (int i = 0; i < 8; ++i)
+    for (int j = 0; j < 8; ++j) b.add_point(Vec<2>(0.3 + 0.05 * (i + 0.5), 0.3 + 0.05 * (j + 0.5)), 0.0025, 1000.0);
+  EXPECT_EQ(s.first_non_finite_kinematics(0), kNotChecked);  // no step yet
+  s.step();
+  EXPECT_EQ(s.first_non_finite_kinematics(0), kAllFinite);
+  EXPECT_EQ(b.law->first_non_finite_stress(), kAllFinite);
+  EXPECT_FALSE(run::first_non_finite(b).has_value());
+  b.v_m_s[45][1] = NAN;  // spreads through the nodes of point 45 to its neighbours in this step
+  s.step();
+  const auto full = run::first_non_finite(b);
+  ASSERT_TRUE(full.has_value());
+  EXPECT_LE(full->point, 45);
+  EXPECT_GT(full->point, 0);
+  EXPECT_EQ(s.first_non_finite_kinematics(0), full->point);
+  EXPECT_EQ(b.law->first_non_finite_stress(), full->point);
 }
 
 TEST(RunScenes, NonFiniteGuardFindsTheFirstBadPointAndWhatIsBad) {

@@ -7,6 +7,7 @@
 // variable; the law updates the body's stress from the body's velocity gradient once per step.
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -17,6 +18,11 @@ namespace oobleck::mpm {
 
 template <class G>
 struct Body;
+
+/// Answers of the NaN guards fused into the step's passes (G2P, the laws): every point finite, or
+/// the pass does not check (otherwise they give the lowest index of a non-finite point).
+inline constexpr std::int64_t kAllFinite = std::numeric_limits<std::int64_t>::max();
+inline constexpr std::int64_t kNotChecked = -1;
 
 /// A stress law for a whole body (one virtual call per body per step; the loop over points and the
 /// per-point pure function are inside). Implementations own their per-point state arrays.
@@ -35,6 +41,9 @@ class StressLaw {
   virtual double viscous_dt_limit(const Body<G>& /*body*/, double /*h_m*/) const { return INFINITY; }
   /// Short name for messages.
   virtual const char* name() const = 0;
+  /// The NaN guard fused into update_stress: the lowest index of a point whose new stress is not
+  /// finite, kAllFinite, or kNotChecked (the default: the runner then scans the stresses itself).
+  virtual std::int64_t first_non_finite_stress() const { return kNotChecked; }
 };
 
 template <class G>

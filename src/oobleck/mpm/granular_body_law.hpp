@@ -86,6 +86,8 @@ class GranularBodyLaw final : public StressLaw<G> {
     return body.size() > 0 ? std::sqrt((K_ + 4.0 * G_ / 3.0) / (phi_min * rho_s_)) : 0.0;
   }
   const char* name() const override { return "granular (E16-E24)"; }
+  /// A non-finite result never reaches the stresses: update_stress throws with the diagnosis.
+  std::int64_t first_non_finite_stress() const override { return kAllFinite; }
   const material::GranularLaw& law() const { return law_; }
 
   std::vector<double> f;                 ///< micro-structure per point

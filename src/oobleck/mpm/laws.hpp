@@ -17,10 +17,15 @@ class LinearElasticLaw final : public StressLaw<G> {
   void resize(std::int64_t) override {}
   void update_stress(Body<G>& body, double dt_s) override {
     const std::int64_t np = body.size();
-#pragma omp parallel for schedule(static)
-    for (std::int64_t q = 0; q < np; ++q)
+    std::int64_t bad = kAllFinite;
+#pragma omp parallel for schedule(static) reduction(min : bad)
+    for (std::int64_t q = 0; q < np; ++q) {
       body.stress_Pa[q] = material::linear_elastic_update(body.stress_Pa[q], body.L_1_s[q], dt_s, p_);
+      if (!std::isfinite(body.stress_Pa[q].sum())) bad = std::min(bad, q);
+    }
+    first_bad_ = bad;
   }
+  std::int64_t first_non_finite_stress() const override { return first_bad_; }
   double max_wave_speed(const Body<G>& body) const override {
     // c = √(M/ρ) at the lightest point (current density m/V), the fastest wave.
     double rho_min = INFINITY;
@@ -33,6 +38,7 @@ class LinearElasticLaw final : public StressLaw<G> {
 
  private:
   material::LinearElasticParams p_;
+  std::int64_t first_bad_ = kNotChecked;
 };
 
 /// Fluid phase of a mixture (E25–E27). State: J = ρ_f0/ρ_f per point. Needs body.phi and
@@ -45,13 +51,17 @@ class FluidLaw final : public StressLaw<G> {
   void resize(std::int64_t n) override { J.resize(static_cast<std::size_t>(n), 1.0); }
   void update_stress(Body<G>& body, double dt_s) override {
     const std::int64_t np = body.size();
-#pragma omp parallel for schedule(static)
+    std::int64_t bad = kAllFinite;
+#pragma omp parallel for schedule(static) reduction(min : bad)
     for (std::int64_t q = 0; q < np; ++q) {
       const double n = std::max(1.0 - body.phi[q], n_min_);
       J[q] = material::update_fluid_volume_ratio(J[q], body.div_q_1_s[q], n, dt_s);  // E27
       body.stress_Pa[q] = material::fluid_cauchy_stress(body.L_1_s[q], body.phi[q], J[q], p_);  // E25, E26
+      if (!std::isfinite(body.stress_Pa[q].sum())) bad = std::min(bad, q);
     }
+    first_bad_ = bad;
   }
+  std::int64_t first_non_finite_stress() const override { return first_bad_; }
   double max_wave_speed(const Body<G>&) const override {
     double J_max = 1.0;
     for (double j : J) J_max = std::max(J_max, j);
@@ -69,6 +79,7 @@ class FluidLaw final : public StressLaw<G> {
  private:
   material::FluidParams p_;
   double n_min_;
+  std::int64_t first_bad_ = kNotChecked;
 };
 
 }  // namespace oobleck::mpm

@@ -248,6 +248,13 @@ class Solver {
     ++steps_;
   }
 
+  /// The NaN guard fused into the last step's G2P for body b: the lowest index of a point whose
+  /// new position, velocity or volume is not finite, kAllFinite, or kNotChecked (rigid bodies, or
+  /// before the first step).
+  std::int64_t first_non_finite_kinematics(int b) const {
+    return static_cast<std::size_t>(b) < non_finite_kinematics_.size() ? non_finite_kinematics_[b] : kNotChecked;
+  }
+
   /// Wall time per part of the step, accumulated since construction or reset_timings().
   const StepTimings& timings() const { return timings_; }
   void reset_timings() { timings_ = {}; }
@@ -469,14 +476,18 @@ class Solver {
 
   template <int K>
   void grid_to_particles_all() {
-    for (std::size_t b = 0; b < bodies_.size(); ++b)
-      if (rigid_[b].rigid())
+    non_finite_kinematics_.resize(bodies_.size());
+    for (std::size_t b = 0; b < bodies_.size(); ++b) {
+      if (rigid_[b].rigid()) {
         move_rigid_points(*bodies_[b], rigid_[b], grid_, opt_.dt_s);
-      else
-        grid_to_particles<G, K>(*bodies_[b], caches_[b], fields_[b], grid_, opt_.transfer,
-                              opt_.flip_fraction, opt_.dt_s,
-                              static_cast<int>(b) == fluid_ ? porosity_.data() : nullptr,
-                              static_cast<int>(b) == fluid_ ? flux_.data() : nullptr);
+        non_finite_kinematics_[b] = kNotChecked;
+      } else {
+        non_finite_kinematics_[b] = grid_to_particles<G, K>(
+            *bodies_[b], caches_[b], fields_[b], grid_, opt_.transfer, opt_.flip_fraction, opt_.dt_s,
+            static_cast<int>(b) == fluid_ ? porosity_.data() : nullptr,
+            static_cast<int>(b) == fluid_ ? flux_.data() : nullptr);
+      }
+    }
   }
 
   void update_stresses() {
@@ -496,6 +507,7 @@ class Solver {
   std::vector<double> mixture_volume_;     ///< nodal grains volume when there is no fluid body
   std::vector<Vec<D>> mixture_gradient_;   ///< nodal mixture mass gradient (combined normals)
   std::vector<ShapeCache<D>> caches_;
+  std::vector<std::int64_t> non_finite_kinematics_;  ///< per body, from the last G2P
   std::vector<GridField<G>> fields_;
   int threads_ = 1;
   int grains_ = -1, fluid_ = -1;

@@ -8,6 +8,7 @@
 // reproducible.
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -257,7 +258,7 @@ namespace detail {
 /// the axisymmetric mode went through the stack with partial stores and wide reloads (store
 /// forwarding stalls); the arithmetic and its order per component are unchanged.
 template <class G, int K, bool Apic, bool ByGrad, bool Mixture>
-void grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& cache, const GridField<G>& field,
+std::int64_t grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& cache, const GridField<G>& field,
                               const Grid<G::dim>& grid, double alpha, double dt_s, const double* porosity,
                               const Vec<G::ncomp>* mixture_flux) {
   constexpr int D = G::dim, NC = G::ncomp, S = support_of<D>(K);
@@ -271,7 +272,8 @@ void grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& cache, co
   Mat<NC, D>* const Cs = body.C_1_s.data();
   Mat3* const Ls = body.L_1_s.data();
   double* const Vs = body.volume_m3.data();
-#pragma omp parallel for schedule(static)
+  std::int64_t bad = kAllFinite;
+#pragma omp parallel for schedule(static) reduction(min : bad)
   for (std::int64_t p = 0; p < np; ++p) {
     // Components 0–1 as one 2-vector (one SIMD register), component 2 (if any) as a scalar.
     V2 vp2 = V2::Zero(), dv2 = V2::Zero(), q2 = V2::Zero(), gv2[D], B2[D];
@@ -371,8 +373,12 @@ void grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& cache, co
     // L at the start-of-step position from the grid velocity field (hoop entries use Σ N v_i).
     const Mat3 L = G::velocity_gradient(gv, x_old, vpic);
     Ls[p] = L;
-    Vs[p] *= std::exp(dt_s * L.trace());  // step 7: V ← V exp(Δt tr L)
+    const double V = Vs[p] * std::exp(dt_s * L.trace());  // step 7: V ← V exp(Δt tr L)
+    Vs[p] = V;
+    // NaN/Inf guard of the new x, v, V (a sum is finite only if every term is)
+    if (!std::isfinite((x.sum() + vs[p].sum()) + V)) bad = std::min(bad, p);
   }
+  return bad;
 }
 
 }  // namespace detail
@@ -385,22 +391,24 @@ void grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& cache, co
 /// For the fluid phase of a mixture, `porosity` (n_i) and `mixture_flux` (q_i = (1−n_i) v^s_i +
 /// n_i v^f_i) are given; the point's φ = 1 − ∑N n_i and div q = ∑ q_i·∇N_ip are stored in
 /// body.phi and body.div_q_1_s for the fluid law (E25, E27).
+///
+/// Returns the lowest index of a point whose new position, velocity or volume is not finite, or
+/// kAllFinite (the run's NaN guard, fused into this pass).
 template <class G, int K>
-void grid_to_particles(Body<G>& body, const ShapeCache<G::dim>& cache, const GridField<G>& field,
-                       const Grid<G::dim>& grid, Transfer transfer, double flip_fraction, double dt_s,
-                       const double* porosity = nullptr, const Vec<G::ncomp>* mixture_flux = nullptr) {
+std::int64_t grid_to_particles(Body<G>& body, const ShapeCache<G::dim>& cache, const GridField<G>& field,
+                               const Grid<G::dim>& grid, Transfer transfer, double flip_fraction, double dt_s,
+                               const double* porosity = nullptr, const Vec<G::ncomp>* mixture_flux = nullptr) {
   const bool mix = porosity != nullptr;
   auto run = [&]<bool A, bool BG>() {
     if (mix)
-      detail::grid_to_particles_kernel<G, K, A, BG, true>(body, cache, field, grid, flip_fraction, dt_s, porosity,
-                                                          mixture_flux);
-    else
-      detail::grid_to_particles_kernel<G, K, A, BG, false>(body, cache, field, grid, flip_fraction, dt_s, nullptr,
-                                                           nullptr);
+      return detail::grid_to_particles_kernel<G, K, A, BG, true>(body, cache, field, grid, flip_fraction, dt_s,
+                                                                 porosity, mixture_flux);
+    return detail::grid_to_particles_kernel<G, K, A, BG, false>(body, cache, field, grid, flip_fraction, dt_s,
+                                                                nullptr, nullptr);
   };
-  if (transfer != Transfer::Apic) run.template operator()<false, false>();
-  else if (cache.apic_by_gradient) run.template operator()<true, true>();
-  else run.template operator()<true, false>();
+  if (transfer != Transfer::Apic) return run.template operator()<false, false>();
+  if (cache.apic_by_gradient) return run.template operator()<true, true>();
+  return run.template operator()<true, false>();
 }
 
 }  // namespace oobleck::mpm
