@@ -80,8 +80,9 @@ inline double pow_term(double x, double alpha, int int_alpha, double& log_x, boo
 }
 
 /// A 3x3 tensor as nine numbers, column-major (Eigen's order), for the functions below that also
-/// run in lanes across points: GCC vectorises an `omp simd` loop that passes these by reference,
-/// but not one that passes pointers to local arrays.
+/// run in lanes across points: GCC 12 vectorises an `omp simd` loop that passes these by reference
+/// to always_inline functions, but not one that passes pointers to local arrays or calls a function
+/// the early inliner leaves out of line (the loop's locals then become per-lane arrays).
 struct T9 {
   double v[9];
 };
@@ -99,6 +100,19 @@ inline bool finite9(const T9& x) {
 }
 inline bool finite3(const Eigen::Matrix3d& m) { return finite9(to9(m)); }
 
+/// The law's input checks (GranularLaw::update): those of the step, dt > 0 and eta_0 > 0 finite, and
+/// those of a point, 0 < phi < 1, f in [0, 1], finite sigma, D, W (branch-free, so that the lanes of
+/// advance_batch vectorise).
+inline bool step_inputs_valid(double dt, double eta_0) {
+  return dt > 0.0 && std::isfinite(dt) && eta_0 > 0.0 && std::isfinite(eta_0);
+}
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline bool point_inputs_valid(double phi, double f, const T9& S, const T9& D, const T9& W) {
+  return (phi > 0.0) & (phi < 1.0) & (f >= 0.0) & (f <= 1.0) & finite9(S) & finite9(D) & finite9(W);
+}
+
 /// E16 trial sig + dt (2 G D + W sig - sig W) + dt (K - 2G/3) tr(D) 1, written out so that it
 /// inlines and vectorises across points. Every sum is formed in the order of the Eigen 3.4
 /// expression it replaces (the SSE2 lazy product sums rows 0-1 as (k0 + k1) + k2 and row 2 as
@@ -107,10 +121,9 @@ inline bool finite3(const Eigen::Matrix3d& m) { return finite9(to9(m)); }
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline T9 jaumann_trial(const T9& S, const T9& D, const T9& W, double dt, double G, double K) {
+inline void jaumann_trial(const T9& S, const T9& D, const T9& W, double dt, double G, double K, T9& r) {
   const double two_G = 2.0 * G;
   auto at = [](const T9& m, int i, int j) { return m.v[i + 3 * j]; };
-  T9 r;
   for (int j = 0; j < 3; ++j) {
     for (int i = 0; i < 3; ++i) {
       double ws, sw;
@@ -127,26 +140,25 @@ inline T9 jaumann_trial(const T9& S, const T9& D, const T9& W, double dt, double
   const double trD = D.v[0] + (D.v[4] + D.v[8]);
   const double vol = dt * (K - two_G / 3.0) * trD;
   for (int i = 0; i < 3; ++i) r.v[4 * i] += vol;
-  return r;
 }
 
-/// The E16 trial of one point: returns the deviator of the trial stress and sets p_tr = -tr/3 and
-/// tau_tr = sqrt(|dev|^2/2). The sums in the order of Eigen's trace() (d00 + (d11 + d22)) and
+/// The E16 trial of one point: s = the deviator of the trial stress, p_tr = -tr/3 and
+/// tau_tr = sqrt(|dev|^2/2). (Results through references: a returned T9 is copied as an aggregate
+/// in the portable build, which stops the vectorisation.) The sums in the order of Eigen's trace() (d00 + (d11 + d22)) and
 /// squaredNorm() (SSE2 pairs summed as two lanes, then the ninth entry), which GCC's Eigen 3.4 uses
 /// for a Matrix3d with or without AVX (with -ffp-contract=off): bit for bit as before.
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline T9 elastic_trial(const T9& S, const T9& D, const T9& W, double dt, double G, double K, double& p_tr,
-                        double& tau_tr) {
-  T9 s = jaumann_trial(S, D, W, dt, G, K);
+inline void elastic_trial(const T9& S, const T9& D, const T9& W, double dt, double G, double K, T9& s,
+                          double& p_tr, double& tau_tr) {
+  jaumann_trial(S, D, W, dt, G, K, s);
   p_tr = -(s.v[0] + (s.v[4] + s.v[8])) / 3.0;
   for (int i = 0; i < 3; ++i) s.v[4 * i] += p_tr;  // dev sigma_tr
   double q[9];
   for (int k = 0; k < 9; ++k) q[k] = s.v[k] * s.v[k];
   const double sq = (((q[0] + q[2]) + (q[4] + q[6])) + ((q[1] + q[3]) + (q[5] + q[7]))) + q[8];
   tau_tr = std::sqrt(0.5 * sq);
-  return s;
 }
 
 // ---- The f_1-only branch of the return map in u = I_m (docs/granular.md), shared by the scalar
@@ -662,8 +674,8 @@ inline GranularUpdate GranularLaw::update_impl(GranularState& state, const Eigen
 inline bool GranularLaw::begin(const GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
                                double dt, double phi, double eta_0, Trial& t, GranularUpdate& out) const {
   // ---- input checks (never throw in the hot loop; report instead) ----
-  if (!(dt > 0.0 && std::isfinite(dt)) || !(phi > 0.0 && phi < 1.0) || !(eta_0 > 0.0 && std::isfinite(eta_0)) ||
-      !(state.f >= 0.0 && state.f <= 1.0) || !finite3(state.sigma) || !finite3(D) || !finite3(W)) {
+  const T9 S = to9(state.sigma), D9 = to9(D), W9 = to9(W);
+  if (!step_inputs_valid(dt, eta_0) || !point_inputs_valid(phi, state.f, S, D9, W9)) {
     out.f_old = state.f;
     out.finite = false;
     out.converged = false;
@@ -671,7 +683,8 @@ inline bool GranularLaw::begin(const GranularState& state, const Eigen::Matrix3d
     return false;
   }
   // ---- E16: elastic trial (D^p = 0), explicit Jaumann rotation with sigma_n ----
-  const T9 s = elastic_trial(to9(state.sigma), to9(D), to9(W), dt, G_, K_, t.p_tr, t.tau_tr);
+  T9 s;
+  elastic_trial(S, D9, W9, dt, G_, K_, s, t.p_tr, t.tau_tr);
   for (int k = 0; k < 9; ++k) t.s.data()[k] = s.v[k];
 
   // ---- E24 ingredients that depend on phi only: f_m (E9), 1/eta_B (E8) ----
@@ -905,8 +918,9 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
         bL[k][i] = L[b0 + i].data()[k];
       }
     }
-    const bool dt_ok = dt > 0.0 && std::isfinite(dt) && eta_0_ > 0.0 && std::isfinite(eta_0_);
     const double G = G_, K = K_;
+    double ok_lane[kBlock];
+    const bool step_ok = step_inputs_valid(dt, eta_0_);
 #pragma omp simd
     for (int i = 0; i < m; ++i) {
       T9 Sx, Dx, Wx;
@@ -918,19 +932,19 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
           Wx.v[ii + 3 * jj] = 0.5 * (bL[ii + 3 * jj][i] - bL[jj + 3 * ii][i]);
         }
       }
-      const T9 sx = elastic_trial(Sx, Dx, Wx, dt, G, K, pt, tt);
+      T9 sx;
+      elastic_trial(Sx, Dx, Wx, dt, G, K, sx, pt, tt);
       const double ff = f[b0 + i], ph = phi[b0 + i];
-      // begin()'s input checks
-      const bool ok = dt_ok & (ph > 0.0) & (ph < 1.0) & (ff >= 0.0) & (ff <= 1.0) & finite9(Sx) & finite9(Dx) &
-                      finite9(Wx);
+      const bool ok = step_ok & point_inputs_valid(ph, ff, Sx, Dx, Wx);  // as begin()
       for (int k = 0; k < 9; ++k) t_s[k][i] = sx.v[k];
-      valid[i] = ok;
+      ok_lane[i] = ok ? 1.0 : 0.0;  // (a bool store here stops the SSE2 vectorisation)
       s_f[i] = ff;
       s_phi[i] = ph;
       s_p_tr[i] = ok ? pt : 1.0;
       s_tau_tr[i] = ok ? tt : 1.0;
       t_fm[i] = rheology::f_m(steady_, ph);
     }
+    for (int i = 0; i < m; ++i) valid[i] = ok_lane[i] != 0.0;
     // E8 on its own: pow() for a non-integer alpha (log and exp of libm) in a loop of independent
     // calls, which the processor overlaps (inside begin() they serialised with the trial)
     for (int i = 0; i < m; ++i) t_inv_eta_B[i] = valid[i] ? inv_eta_B(phi[b0 + i]) : 0.0;
