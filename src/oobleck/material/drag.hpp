@@ -13,6 +13,7 @@
 //
 // The grains receive −f_d, the fluid +f_d (per unit mixture volume).
 #include <cmath>
+#include <numbers>
 
 namespace oobleck::material {
 
@@ -31,8 +32,12 @@ inline double beetstra_F(double phi, double Re) {
   const double n = 1.0 - phi;
   double F = 10.0 * phi / (n * n) + n * n * (1.0 + 1.5 * std::sqrt(phi));
   if (Re > 0.0) {
-    const double num = 1.0 / n + 3.0 * phi * n + 8.4 * std::pow(Re, -0.343);
-    const double den = 1.0 + std::pow(10.0, 3.0 * phi) * std::pow(Re, -0.5 * (1.0 + 4.0 * phi));
+    // The powers through one logarithm and two exponentials (instead of three pow calls: the
+    // nodal drag is evaluated at every mixture node and step); relative difference < 2e-14 for
+    // 1e-12 < Re < 1e3.
+    const double ln_Re = std::log(Re);
+    const double num = 1.0 / n + 3.0 * phi * n + 8.4 * std::exp(-0.343 * ln_Re);
+    const double den = 1.0 + std::exp(3.0 * phi * std::numbers::ln10 - 0.5 * (1.0 + 4.0 * phi) * ln_Re);
     F += 0.413 * Re / (24.0 * n * n) * num / den;
   }
   return F;

@@ -35,6 +35,15 @@ struct PlaneStrain {
     L.topLeftCorner<2, 2>() = grad_v;
     return L;
   }
+  /// velocity_gradient written entry by entry into L (column-major 3×3) from its columns
+  /// g_a = ∑ v_i ∂_a N_ip (G2P's hot path: no temporary matrix); returns tr L.
+  static double write_velocity_gradient(double* L, const double* g0, const double* g1, const Vec<dim>& /*x*/,
+                                        const double* /*v*/) {
+    L[0] = g0[0], L[1] = g0[1], L[2] = 0.0;
+    L[3] = g1[0], L[4] = g1[1], L[5] = 0.0;
+    L[6] = 0.0, L[7] = 0.0, L[8] = 0.0;
+    return (L[0] + L[4]) + L[8];  // the order of Mat3::trace()
+  }
 };
 
 /// Full 3D: (x, y, z) grid and velocity.
@@ -69,6 +78,14 @@ struct Axisymmetric {
     L(0, 2) = -v[2] / x[0];
     L(2, 2) = v[0] / x[0];
     return L;
+  }
+  /// velocity_gradient written entry by entry (see PlaneStrain); returns tr L.
+  static double write_velocity_gradient(double* L, const double* g0, const double* g1, const Vec<dim>& x,
+                                        const double* v) {
+    L[0] = g0[0], L[1] = g0[1], L[2] = g0[2];
+    L[3] = g1[0], L[4] = g1[1], L[5] = g1[2];
+    L[6] = -v[2] / x[0], L[7] = 0.0, L[8] = v[0] / x[0];
+    return (L[0] + L[4]) + L[8];
   }
   static Vec<ncomp> hoop_force(const Mat3& sigma, const Vec<dim>& x, double V) {
     return Vec<ncomp>(-sigma(2, 2) * V / x[0], 0.0, sigma(0, 2) * V / x[0]);

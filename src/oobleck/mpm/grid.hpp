@@ -88,14 +88,19 @@ struct Grid {
   double cell_volume() const { return std::pow(h_m, D); }
   /// Wrap a position into the periodic range on periodic axes.
   void wrap(Vec<D>& x) const {
-    for (int a = 0; a < D; ++a) {
-      if (!periodic[a]) continue;
-      const double L = length(a);
-      double r = x[a] - origin_m[a];
-      r -= L * std::floor(r / L);
-      if (r >= L) r -= L;  // guards r == L after round-off
-      x[a] = origin_m[a] + r;
-    }
+    for (int a = 0; a < D; ++a) x[a] = wrapped(a, x[a]);
+  }
+  /// Coordinate x_a wrapped into the periodic range (unchanged on a non-periodic axis).
+  double wrapped(int a, double xa) const {
+    if (!periodic[a]) return xa;
+    const double L = length(a);
+    double r = xa - origin_m[a];
+    // Inside the range (away from its end by more than round-off) floor(r/L) = 0: the same
+    // result without the division.
+    if (r >= 0.0 && r <= L * (1.0 - 1e-10)) return origin_m[a] + r;
+    r -= L * std::floor(r / L);
+    if (r >= L) r -= L;  // guards r == L after round-off
+    return origin_m[a] + r;
   }
 };
 

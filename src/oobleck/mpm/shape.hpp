@@ -9,6 +9,7 @@
 // (∑N = 1, ∑∇N = 0, ∑N x_i = x_p), which the tests check near walls and periodic seams too.
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -18,18 +19,39 @@ namespace oobleck::mpm {
 
 enum class ShapeKind { Linear, QuadraticBSpline, CubicBSpline, UGimp };
 
+namespace kernel_detail {
+inline double floor_of(double x) { return std::floor(x); }
+template <class A>
+auto floor_of(const A& x) {
+  return x.floor().eval();
+}
+template <class T>
+T constant(double v) {
+  if constexpr (std::is_same_v<T, double>) return v;
+  else return T::Constant(v);
+}
+}  // namespace kernel_detail
+
 /// Multilinear hat functions (support 2 nodes per axis).
 struct LinearKernel {
   static constexpr int support = 2;
   /// APIC with linear weights uses C_p = ∑ v_i ∇N_ipᵀ (Jiang et al. 2015); D_p is singular at nodes.
   static constexpr bool apic_by_gradient = true;
-  void operator()(double xi, int& base, double* w, double* dw) const {
-    base = static_cast<int>(std::floor(xi));
-    const double f = xi - base;
+  /// T = double (one axis) or an Eigen array (all axes at once, the same operations per lane);
+  /// base is the first support node as a floating-point integer.
+  template <class T>
+  void axes(const T& xi, T& base, T* w, T* dw) const {
+    base = kernel_detail::floor_of(xi);
+    const T f = xi - base;
     w[0] = 1.0 - f;
     w[1] = f;
-    dw[0] = -1.0;
-    dw[1] = 1.0;
+    dw[0] = kernel_detail::constant<T>(-1.0);
+    dw[1] = kernel_detail::constant<T>(1.0);
+  }
+  void operator()(double xi, int& base, double* w, double* dw) const {
+    double b = 0.0;
+    axes(xi, b, w, dw);
+    base = static_cast<int>(b);
   }
 };
 
@@ -37,16 +59,23 @@ struct LinearKernel {
 struct QuadraticBSplineKernel {
   static constexpr int support = 3;
   static constexpr bool apic_by_gradient = false;
-  void operator()(double xi, int& base, double* w, double* dw) const {
-    base = static_cast<int>(std::floor(xi - 0.5));
-    const double f = xi - base;  // in [0.5, 1.5)
-    const double a = 1.5 - f, b = f - 1.0, c = f - 0.5;
+  /// As LinearKernel::axes.
+  template <class T>
+  void axes(const T& xi, T& base, T* w, T* dw) const {
+    base = kernel_detail::floor_of(xi - 0.5);
+    const T f = xi - base;  // in [0.5, 1.5)
+    const T a = 1.5 - f, b = f - 1.0, c = f - 0.5;
     w[0] = 0.5 * a * a;
     w[1] = 0.75 - b * b;
     w[2] = 0.5 * c * c;
     dw[0] = -a;
     dw[1] = -2.0 * b;
     dw[2] = c;
+  }
+  void operator()(double xi, int& base, double* w, double* dw) const {
+    double b = 0.0;
+    axes(xi, b, w, dw);
+    base = static_cast<int>(b);
   }
 };
 
@@ -107,17 +136,18 @@ struct UGimpKernel {
 /// Largest support (nodes per axis) of any kernel.
 inline constexpr int kMaxSupport = 4;
 
-/// The 1D factors of one point's shape functions: for axis a and its support node j < S, the
+/// The 1D factors of one point's shape functions: for support node j < S and axis a, the
 /// storage index times the axis stride of node base + j (periodic seams wrapped), N, dN/dx [1/m]
 /// and x_i − x_p [m]. The D-dimensional values are tensor products formed on the fly
 /// (for_each_node): per point this stores 4 D S numbers instead of S^D nodes × (2 + 2D) numbers,
-/// so the shape pass writes, and P2G/G2P read, a fraction of the bytes.
+/// so the shape pass writes, and P2G/G2P read, a fraction of the bytes. The axis is the inner
+/// index so that make_stencil computes and stores the D axes of one j together (one SIMD store).
 template <int D, int S>
 struct Stencil {
-  int index[D][S];
-  double w[D][S];
-  double dw[D][S];
-  double off[D][S];
+  int index[S][D];
+  double w[S][D];
+  double dw[S][D];
+  double off[S][D];
 };
 
 /// Support per axis S of a kernel with K = S^D nodes per point.
@@ -143,27 +173,27 @@ inline void for_each_node(const Stencil<D, S>& s, F&& f) {
   static_assert(D >= 1 && D <= 3 && S >= 1 && S <= kMaxSupport);
   if constexpr (D == 1) {
     for (int j0 = 0; j0 < S; ++j0) {
-      const double g[1] = {s.dw[0][j0]}, o[1] = {s.off[0][j0]};
-      f(s.index[0][j0], s.w[0][j0], g, o);
+      const double g[1] = {s.dw[j0][0]}, o[1] = {s.off[j0][0]};
+      f(s.index[j0][0], s.w[j0][0], g, o);
     }
   } else if constexpr (D == 2) {
     for (int j0 = 0; j0 < S; ++j0) {
       for (int j1 = 0; j1 < S; ++j1) {
-        const double g[2] = {s.dw[0][j0] * s.w[1][j1], s.w[0][j0] * s.dw[1][j1]};
-        const double o[2] = {s.off[0][j0], s.off[1][j1]};
-        f(s.index[0][j0] + s.index[1][j1], s.w[0][j0] * s.w[1][j1], g, o);
+        const double g[2] = {s.dw[j0][0] * s.w[j1][1], s.w[j0][0] * s.dw[j1][1]};
+        const double o[2] = {s.off[j0][0], s.off[j1][1]};
+        f(s.index[j0][0] + s.index[j1][1], s.w[j0][0] * s.w[j1][1], g, o);
       }
     }
   } else {
     for (int j0 = 0; j0 < S; ++j0) {
       for (int j1 = 0; j1 < S; ++j1) {
-        const double w01 = s.w[0][j0] * s.w[1][j1];
-        const double g0 = s.dw[0][j0] * s.w[1][j1], g1 = s.dw[1][j1] * s.w[0][j0];
-        const int i01 = s.index[0][j0] + s.index[1][j1];
+        const double w01 = s.w[j0][0] * s.w[j1][1];
+        const double g0 = s.dw[j0][0] * s.w[j1][1], g1 = s.dw[j1][1] * s.w[j0][0];
+        const int i01 = s.index[j0][0] + s.index[j1][1];
         for (int j2 = 0; j2 < S; ++j2) {
-          const double g[3] = {g0 * s.w[2][j2], g1 * s.w[2][j2], (s.dw[2][j2] * s.w[0][j0]) * s.w[1][j1]};
-          const double o[3] = {s.off[0][j0], s.off[1][j1], s.off[2][j2]};
-          f(i01 + s.index[2][j2], w01 * s.w[2][j2], g, o);
+          const double g[3] = {g0 * s.w[j2][2], g1 * s.w[j2][2], (s.dw[j2][2] * s.w[j0][0]) * s.w[j1][1]};
+          const double o[3] = {s.off[j0][0], s.off[j1][1], s.off[j2][2]};
+          f(i01 + s.index[j2][2], w01 * s.w[j2][2], g, o);
         }
       }
     }
@@ -208,14 +238,14 @@ struct ShapeCache {
   int node(std::int64_t p, int k) const {
     return visit(p, k, [](const auto& s, const int* j) {
       int i = 0;
-      for (int a = 0; a < D; ++a) i += s.index[a][j[a]];
+      for (int a = 0; a < D; ++a) i += s.index[j[a]][a];
       return i;
     });
   }
   double weight(std::int64_t p, int k) const {
     return visit(p, k, [](const auto& s, const int* j) {
       double w = 1.0;
-      for (int a = 0; a < D; ++a) w *= s.w[a][j[a]];
+      for (int a = 0; a < D; ++a) w *= s.w[j[a]][a];
       return w;
     });
   }
@@ -223,9 +253,9 @@ struct ShapeCache {
     return visit(p, k, [](const auto& s, const int* j) {
       Vec<D> g;
       for (int a = 0; a < D; ++a) {
-        double ga = s.dw[a][j[a]];
+        double ga = s.dw[j[a]][a];
         for (int b = 0; b < D; ++b)
-          if (b != a) ga *= s.w[b][j[b]];
+          if (b != a) ga *= s.w[j[b]][b];
         g[a] = ga;
       }
       return g;
@@ -234,7 +264,7 @@ struct ShapeCache {
   Vec<D> offset(std::int64_t p, int k) const {
     return visit(p, k, [](const auto& s, const int* j) {
       Vec<D> o;
-      for (int a = 0; a < D; ++a) o[a] = s.off[a][j[a]];
+      for (int a = 0; a < D; ++a) o[a] = s.off[j[a]][a];
       return o;
     });
   }
@@ -287,8 +317,17 @@ struct StencilGrid {
   }
 };
 
+/// Whether a kernel evaluates all axes at once on Eigen arrays (`axes`); the others go axis by axis.
+template <class Kernel, int D>
+concept AxesKernel = requires(const Kernel& k, const Eigen::Array<double, D, 1>& xi, Eigen::Array<double, D, 1>& b,
+                              Eigen::Array<double, D, 1>* w) { k.axes(xi, b, w, w); };
+
 /// The stencil of a point at x and the diagonal of APIC's D_p⁻¹ [1/m²]. Returns false when the
 /// support leaves the stored nodes (non-periodic axes; those indices are set to 0).
+///
+/// The D axes are computed side by side in Eigen arrays (one SIMD lane per axis for D = 2) with
+/// exactly the operations of the 1D kernel per lane, so the values equal the axis-by-axis ones; the
+/// shape pass is bound by its stores, and those of one support node j go out together.
 template <int D, class Kernel>
 #if defined(__GNUC__)
 [[gnu::always_inline]]
@@ -296,35 +335,53 @@ template <int D, class Kernel>
 inline bool make_stencil(const Grid<D>& grid, const StencilGrid<D>& sg, const Kernel& kernel, const Vec<D>& x,
                          Stencil<D, Kernel::support>& s, Vec<D>& inv_D) {
   constexpr int S = Kernel::support;
+  using A = Eigen::Array<double, D, 1>;
+  A xi, basef, w[S], dw[S];
+  for (int a = 0; a < D; ++a) xi[a] = (x[a] - sg.origin[a]) * sg.inv_h;
+  if constexpr (AxesKernel<Kernel, D>) {
+    kernel.axes(xi, basef, w, dw);
+  } else {
+    for (int a = 0; a < D; ++a) {
+      int base = 0;
+      double w1[S], dw1[S];
+      kernel(xi[a], base, w1, dw1);
+      basef[a] = base;
+      for (int j = 0; j < S; ++j) {
+        w[j][a] = w1[j];
+        dw[j][a] = dw1[j];
+      }
+    }
+  }
+  A m2 = A::Zero();
+  for (int j = 0; j < S; ++j) {
+    const A off = ((basef + static_cast<double>(j)) - xi) * sg.h;
+    m2 += w[j] * off * off;
+    Eigen::Map<A>(s.w[j]) = w[j];
+    Eigen::Map<A>(s.dw[j]) = dw[j] * sg.inv_h;
+    Eigen::Map<A>(s.off[j]) = off;
+  }
+  const A inv_m2 = 1.0 / m2;  // all lanes in one division (1/0 = inf is not selected)
+  inv_D = (m2 > 0.0).select(inv_m2, 0.0).matrix();
+  // Storage indices of base … base + S − 1 (= grid.storage_index, one modulo per axis).
   bool ok = true;
   for (int a = 0; a < D; ++a) {
-    const double xi = (x[a] - sg.origin[a]) * sg.inv_h;
-    int base = 0;
-    kernel(xi, base, s.w[a], s.dw[a]);
-    double m2 = 0.0;
-    for (int j = 0; j < S; ++j) {
-      s.dw[a][j] *= sg.inv_h;
-      s.off[a][j] = (base + j - xi) * sg.h;
-      m2 += s.w[a][j] * s.off[a][j] * s.off[a][j];
-    }
-    // Storage indices of base … base + S − 1 (= grid.storage_index, one modulo per axis).
+    const int base = static_cast<int>(basef[a]);
     if (sg.periodic[a]) {
       // base is within one cell of [0, cells) for a wrapped point: no integer division then.
       int st = base < 0 ? base + sg.nodes[a] : base;
       if (st < 0 || st >= sg.nodes[a]) st = grid.storage_index(a, base);
       for (int j = 0; j < S; ++j, ++st) {
         if (st >= sg.nodes[a]) st -= sg.nodes[a];
-        s.index[a][j] = st * sg.stride[a];
+        s.index[j][a] = st * sg.stride[a];
       }
     } else {
       for (int j = 0; j < S; ++j) {
         const int st = base + j + Grid<D>::kGhost;
         const bool in = st >= 0 && st < sg.nodes[a];
         ok = ok && in;
-        s.index[a][j] = in ? st * sg.stride[a] : 0;
+        s.index[j][a] = in ? st * sg.stride[a] : 0;
       }
     }
-    inv_D[a] = m2 > 0.0 ? 1.0 / m2 : 0.0;
   }
   return ok;
 }

@@ -82,7 +82,7 @@ inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim
     Mat3 sig = body.stress_Pa[p];
     double Vpres = 0.0;
     if constexpr (Split) {
-      const double pres = -sig.trace() / 3.0;
+      const double pres = -sig.trace() * (1.0 / 3.0);  // (a multiplication: off the critical path)
       sig.diagonal().array() += pres;  // τ = σ + p 1
       Vpres = Vp * pres;
     }
@@ -117,6 +117,62 @@ inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim
     }
     const V2 v2(v[0], v[1]), fpt2(fpt[0], fpt[1]);
     const double v3 = v[NC - 1], fpt3 = fpt[NC - 1];
+    if constexpr (D == 2) {
+      // The tensor product factorised (docs/mpm.md, "Factorised transfers"): with N = N_0 N_1,
+      // ∇N = (N'_0 N_1, N_0 N'_1) and x_i − x_p = (o_0, o_1), every nodal term is
+      // N_1 (a per-row value) + N'_1 or N_1 o_1 (another per-row value); the per-row values are
+      // formed once for each of the S rows j0, so a node costs a few multiply-adds.
+      const Stencil<D, S>& st = cache.template stencil<S>(p);
+      V2 W1[S], DW1[S], WO1[S], WD1[S];
+      for (int j1 = 0; j1 < S; ++j1) {
+        WD1[j1] = V2(st.w[j1][1], st.dw[j1][1]);
+        W1[j1] = V2::Constant(st.w[j1][1]);
+        DW1[j1] = V2::Constant(st.dw[j1][1]);
+        WO1[j1] = V2::Constant(st.w[j1][1] * st.off[j1][1]);
+      }
+      for (int j0 = 0; j0 < S; ++j0) {
+        const double w0 = st.w[j0][0], dw0 = st.dw[j0][0], o0 = st.off[j0][0];
+        const double P = mp * w0;  // m_p N_0
+        // momentum: N m_p (v + C (x_i − x_p)) = N_1 P (v + C_0 o_0) + N_1 o_1 P C_1
+        V2 U2 = P * v2, Vc2 = V2::Zero();
+        double U3 = P * v3, Vc3 = 0.0;
+        if constexpr (Apic) {
+          U2 = P * (v2 + Cp2[0] * o0);
+          Vc2 = P * Cp2[1];
+          U3 = P * (v3 + Cp3[0] * o0);
+          Vc3 = P * Cp3[1];
+        }
+        // force: −V σ ∇N + N f_pt = N_1 (N_0 f_pt − N'_0 V σ_0) − N'_1 N_0 V σ_1
+        const V2 E2 = w0 * fpt2 - dw0 * Vsig2[0], nB2 = -w0 * Vsig2[1];
+        const double E3 = w0 * fpt3 - dw0 * Vsig3[0], nB3 = -w0 * Vsig3[1];
+        const V2 PV2(Vpres * dw0, Vpres * w0);
+        const int row = st.index[j0][0];
+        for (int j1 = 0; j1 < S; ++j1) {
+          const int i = row + st.index[j1][1];
+          const double w1 = st.w[j1][1], dw1 = st.dw[j1][1];
+          double* mvi = mv + static_cast<std::int64_t>(i) * NC;
+          double* fi = f + static_cast<std::int64_t>(i) * NC;
+          m[i] += P * w1;
+          Eigen::Map<V2> mvi2(mvi), fi2(fi);
+          if constexpr (Apic) mvi2 += W1[j1].cwiseProduct(U2) + WO1[j1].cwiseProduct(Vc2);
+          else mvi2 += W1[j1].cwiseProduct(U2);
+          fi2 += W1[j1].cwiseProduct(E2) + DW1[j1].cwiseProduct(nB2);
+          if constexpr (NC == 3) {
+            if constexpr (Apic) mvi[2] += w1 * U3 + (w1 * st.off[j1][1]) * Vc3;
+            else mvi[2] += w1 * U3;
+            fi[2] += w1 * E3 + dw1 * nB3;
+          }
+          if constexpr (Split) {
+            double* fpi = fp + static_cast<std::int64_t>(i) * NC;
+            Eigen::Map<V2>(fpi) += PV2.cwiseProduct(WD1[j1]);  // V_p p (N'_0 N_1, N_0 N'_1)
+            if constexpr (G::has_hoop_terms)
+              for (int c = 0; c < NC; ++c) fpi[c] += w1 * (w0 * fppt[c]);
+            vol[i] += (w0 * Vp) * w1;
+          }
+        }
+      }
+      return;
+    }
     for_each_node<D, S>(cache.template stencil<S>(p), [&](int i, double w, const double* g, const double* off) {
       const double wm = w * mp;
       double* mvi = mv + static_cast<std::int64_t>(i) * NC;
@@ -285,6 +341,81 @@ std::int64_t grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& c
       B3[a] = 0.0;
     }
     double n_p = 0.0, div_q = 0.0;
+    if constexpr (D == 2) {
+      // The tensor product factorised (as in P2G): per row j0 the sums over j1 of N_1 v_i,
+      // N'_1 v_i and N_1 o_1 v_i, then ∑N v = ∑ N_0 (∑N_1 v), ∇: (∑ N'_0 (∑N_1 v), ∑ N_0 (∑N'_1 v)),
+      // B = ∑N v (x_i − x_p)ᵀ = (∑ N_0 o_0 (∑N_1 v), ∑ N_0 (∑N_1 o_1 v)).
+      const Stencil<D, S>& st = cache.template stencil<S>(p);
+      V2 W1[S], DW1[S], WO1[S];
+      for (int j1 = 0; j1 < S; ++j1) {
+        W1[j1] = V2::Constant(st.w[j1][1]);
+        DW1[j1] = V2::Constant(st.dw[j1][1]);
+        WO1[j1] = V2::Constant(st.w[j1][1] * st.off[j1][1]);
+      }
+      for (int j0 = 0; j0 < S; ++j0) {
+        const double w0 = st.w[j0][0], dw0 = st.dw[j0][0], o0 = st.off[j0][0];
+        V2 t2 = V2::Zero(), tg2 = V2::Zero(), to2 = V2::Zero(), td2 = V2::Zero(), tq2 = V2::Zero();
+        double t3 = 0.0, tg3 = 0.0, to3 = 0.0, td3 = 0.0, tq3 = 0.0, tn = 0.0, tqy = 0.0;
+        const int row = st.index[j0][0];
+        for (int j1 = 0; j1 < S; ++j1) {
+          const int i = row + st.index[j1][1];
+          const double w1 = st.w[j1][1], dw1 = st.dw[j1][1];
+          const double* vi = vel + static_cast<std::int64_t>(i) * NC;
+          const V2 vi2 = Eigen::Map<const V2>(vi);
+          t2 += W1[j1].cwiseProduct(vi2);
+          tg2 += DW1[j1].cwiseProduct(vi2);
+          if constexpr (NC == 3) {
+            t3 += w1 * vi[2];
+            tg3 += dw1 * vi[2];
+          }
+          if constexpr (Apic && !ByGrad) {
+            to2 += WO1[j1].cwiseProduct(vi2);
+            if constexpr (NC == 3) to3 += (w1 * st.off[j1][1]) * vi[2];
+          }
+          if constexpr (!Apic) {
+            const double* vo = vel_old + static_cast<std::int64_t>(i) * NC;
+            td2 += W1[j1].cwiseProduct(vi2 - Eigen::Map<const V2>(vo));
+            if constexpr (NC == 3) td3 += w1 * (vi[2] - vo[2]);
+          }
+          if constexpr (Mixture) {
+            const double* qi = flux + static_cast<std::int64_t>(i) * NC;
+            tn += w1 * porosity[i];
+            tq2 += W1[j1].cwiseProduct(Eigen::Map<const V2>(qi));
+            tqy += dw1 * qi[1];
+            if constexpr (G::has_hoop_terms) tq3 += w1 * qi[2];
+          }
+        }
+        vp2 += w0 * t2;
+        gv2[0] += dw0 * t2;
+        gv2[1] += w0 * tg2;
+        if constexpr (NC == 3) {
+          vp3 += w0 * t3;
+          gv3[0] += dw0 * t3;
+          gv3[1] += w0 * tg3;
+        }
+        if constexpr (Apic && !ByGrad) {
+          B2[0] += (w0 * o0) * t2;
+          B2[1] += w0 * to2;
+          if constexpr (NC == 3) {
+            B3[0] += (w0 * o0) * t3;
+            B3[1] += w0 * to3;
+          }
+        }
+        if constexpr (!Apic) {
+          dv2 += w0 * td2;
+          if constexpr (NC == 3) dv3 += w0 * td3;
+        }
+        if constexpr (Mixture) {
+          n_p += w0 * tn;
+          div_q += dw0 * tq2[0] + w0 * tqy;
+          if constexpr (G::has_hoop_terms) {
+            q2 += w0 * tq2;
+            q3 += w0 * tq3;
+          }
+        }
+        (void)o0;
+      }
+    } else {
     for_each_node<D, S>(cache.template stencil<S>(p), [&](int i, double w, const double* g, const double* off) {
       const double* vi = vel + static_cast<std::int64_t>(i) * NC;
       const V2 vi2 = Eigen::Map<const V2>(vi);
@@ -322,6 +453,66 @@ std::int64_t grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& c
       }
       (void)off;
     });
+    }
+    if constexpr (D == 2) {
+      // The point's update written straight from the accumulators to its arrays, component by
+      // component (a temporary vector or matrix filled by parts and read whole stalls on store
+      // forwarding); the same values as the general path below.
+      double* const xp = xs[p].data();
+      const double x_old0 = xp[0], x_old1 = xp[1];
+      const double xn0 = grid.wrapped(0, x_old0 + dt_s * vp2[0]), xn1 = grid.wrapped(1, x_old1 + dt_s * vp2[1]);
+      xp[0] = xn0;
+      xp[1] = xn1;
+      double* const vq = vs[p].data();
+      double v_new[NC];
+      if constexpr (Apic) {
+        Eigen::Map<V2>{v_new} = vp2;
+        if constexpr (NC == 3) v_new[2] = vp3;
+      } else {
+        const V2 vb = alpha * (Eigen::Map<const V2>(vq) + dv2) + (1.0 - alpha) * vp2;
+        Eigen::Map<V2>{v_new} = vb;
+        if constexpr (NC == 3) v_new[2] = alpha * (vq[2] + dv3) + (1.0 - alpha) * vp3;
+      }
+      double v_pic[NC];
+      Eigen::Map<V2>{v_pic} = vp2;
+      if constexpr (NC == 3) v_pic[2] = vp3;
+      for (int c = 0; c < NC; ++c) vq[c] = v_new[c];
+      double g[D][NC];
+      for (int a = 0; a < D; ++a) {
+        Eigen::Map<V2>{g[a]} = gv2[a];
+        if constexpr (NC == 3) g[a][2] = gv3[a];
+      }
+      if constexpr (Apic) {
+        double* const Cq = Cs[p].data();  // column-major NC × D
+        for (int a = 0; a < D; ++a) {
+          if constexpr (ByGrad) {
+            for (int c = 0; c < NC; ++c) Cq[a * NC + c] = g[a][c];
+          } else {
+            const double sD = inv_D[p * D + a];
+            Eigen::Map<V2>(Cq + a * NC) = B2[a] * sD;
+            if constexpr (NC == 3) Cq[a * NC + 2] = B3[a] * sD;
+          }
+        }
+      }
+      const Vec<D> x_old(x_old0, x_old1);
+      if constexpr (Mixture) {
+        if constexpr (G::has_hoop_terms) {
+          const Vec<NC> qp(q2[0], q2[1], q3);
+          div_q += G::div_extra(qp, x_old);
+        }
+        body.phi[p] = 1.0 - n_p;
+        body.div_q_1_s[p] = div_q;
+      }
+      // L at the start-of-step position from the grid velocity field (hoop entries use Σ N v_i).
+      const double trL = G::write_velocity_gradient(Ls[p].data(), g[0], g[1], x_old, v_pic);
+      const double V = Vs[p] * std::exp(dt_s * trL);  // step 7: V ← V exp(Δt tr L)
+      Vs[p] = V;
+      double vsum = v_new[0];
+      for (int c = 1; c < NC; ++c) vsum += v_new[c];
+      // NaN/Inf guard of the new x, v, V (a sum is finite only if every term is)
+      if (!std::isfinite(((xn0 + xn1) + vsum) + V)) bad = std::min(bad, p);
+      continue;
+    }
     double v_pic[NC], dv[NC], q_p[NC], grad_v[D][NC], B[D][NC];  // column-major like Mat<NC, D>
     for (int c = 0; c < 2; ++c) {
       v_pic[c] = vp2[c];
