@@ -75,8 +75,9 @@ struct Axisymmetric {
   static Mat3 velocity_gradient(const Mat<ncomp, dim>& grad_v, const Vec<dim>& x, const Vec<ncomp>& v) {
     Mat3 L = Mat3::Zero();
     L.leftCols<2>() = grad_v;
-    L(0, 2) = -v[2] / x[0];
-    L(2, 2) = v[0] / x[0];
+    const double ir = 1.0 / x[0];
+    L(0, 2) = -v[2] * ir;
+    L(2, 2) = v[0] * ir;
     return L;
   }
   /// velocity_gradient written entry by entry (see PlaneStrain); returns tr L.
@@ -84,14 +85,17 @@ struct Axisymmetric {
                                         const double* v) {
     L[0] = g0[0], L[1] = g0[1], L[2] = g0[2];
     L[3] = g1[0], L[4] = g1[1], L[5] = g1[2];
-    L[6] = -v[2] / x[0], L[7] = 0.0, L[8] = v[0] / x[0];
+    const double ir = 1.0 / x[0];
+    L[6] = -v[2] * ir, L[7] = 0.0, L[8] = v[0] * ir;
     return (L[0] + L[4]) + L[8];
   }
   static Vec<ncomp> hoop_force(const Mat3& sigma, const Vec<dim>& x, double V) {
-    return Vec<ncomp>(-sigma(2, 2) * V / x[0], 0.0, sigma(0, 2) * V / x[0]);
+    const double Vr = V / x[0];  // (one division: P2G calls these per point)
+    return Vec<ncomp>(-sigma(2, 2) * Vr, 0.0, sigma(0, 2) * Vr);
   }
   static Vec<ncomp> inertial_acceleration(const Vec<dim>& x, const Vec<ncomp>& v) {
-    return Vec<ncomp>(v[2] * v[2] / x[0], 0.0, -v[0] * v[2] / x[0]);
+    const double ir = 1.0 / x[0];
+    return Vec<ncomp>(v[2] * v[2] * ir, 0.0, -v[0] * v[2] * ir);
   }
   static double div_extra(const Vec<ncomp>& q, const Vec<dim>& x) { return q[0] / x[0]; }
 };

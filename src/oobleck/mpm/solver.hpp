@@ -72,8 +72,8 @@ inline int kernel_support(ShapeKind k) {
 
 /// Accumulated wall time [s] per part of the step (where the time goes).
 struct StepTimings {
-  double shape = 0, p2g = 0, grid = 0, g2p = 0, stress = 0;
-  double total() const { return shape + p2g + grid + g2p + stress; }
+  double p2g = 0, grid = 0, g2p = 0, stress = 0;  ///< p2g includes the shape functions (fused)
+  double total() const { return p2g + grid + g2p + stress; }
 };
 
 template <class G>
@@ -226,9 +226,8 @@ class Solver {
       constexpr int K = ipow(decltype(S)::value, D);
       StepClock clock(timings_);
       apply_motors();                      // 3'. wheel motor (velocity level, §8) before P2G
-      compute_shape_functions();           // 1. N_ip, ∇N_ip cached per point
-      clock.lap(timings_.shape);
-      particles_to_grid_all<K>();          // 2. mass, momentum, internal force
+      particles_to_grid_all<K>();          // 1. N_ip, ∇N_ip cached per point, fused with
+                                           // 2. mass, momentum, internal force
       clock.lap(timings_.p2g);
       apply_body_loads();                  // 3. gravity (motors later)
       fold_wall_images_all();              // 4a. walls: ghost contributions onto mirrors
@@ -281,11 +280,19 @@ class Solver {
     }
   }
 
-  void compute_shape_functions() {
+  /// Steps 1–2 for every body: each point's shape functions (into its body's cache) and its
+  /// scatter (particles_to_grid).
+  template <int K>
+  void particles_to_grid_all() {
     omp_set_num_threads(threads_);
+    const bool apic = opt_.transfer == Transfer::Apic;
     for (std::size_t b = 0; b < bodies_.size(); ++b) {
-      const std::int64_t bad = with_kernel(opt_.shape, opt_.gimp_half_width_cells, [&](auto kernel) {
-        return compute_shape_cache(grid_, kernel, bodies_[b]->x_m, caches_[b]);
+      const std::int64_t bad = with_kernel(opt_.shape, opt_.gimp_half_width_cells, [&](auto kernel) -> std::int64_t {
+        if constexpr (decltype(kernel)::support == support_of<D>(K))
+          return particles_to_grid<G, K>(*bodies_[b], grid_, kernel, caches_[b], fields_[b], apic,
+                                         static_cast<int>(b) == fluid_);
+        else
+          return 0;  // not reached: with_support and with_kernel read the same option
       });
       if (bad > 0)
         throw NumericalError(fmt::format(
@@ -293,13 +300,6 @@ class Solver {
             "step {}, t = {} s",
             bad, bodies_[b]->name, steps_, time_s_));
     }
-  }
-
-  template <int K>
-  void particles_to_grid_all() {
-    const bool apic = opt_.transfer == Transfer::Apic;
-    for (std::size_t b = 0; b < bodies_.size(); ++b)
-      particles_to_grid<G, K>(*bodies_[b], caches_[b], fields_[b], apic, static_cast<int>(b) == fluid_);
   }
 
   bool mixture() const { return grains_ >= 0 && fluid_ >= 0; }

@@ -19,6 +19,13 @@
 
 namespace oobleck::mpm {
 
+// Full unrolling of the S-node loops of the factorised transfers (S ≤ 4).
+#if defined(__GNUC__) && !defined(__clang__)
+#define OOBLECK_UNROLL _Pragma("GCC unroll 4")
+#else
+#define OOBLECK_UNROLL
+#endif
+
 /// Velocity transfer of G2P: FLIP/PIC blend (α = flip_fraction; 1 = pure FLIP, 0 = PIC) or APIC.
 enum class Transfer { FlipPicBlend, Apic };
 
@@ -130,6 +137,7 @@ inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim
         DW1[j1] = V2::Constant(st.dw[j1][1]);
         WO1[j1] = V2::Constant(st.w[j1][1] * st.off[j1][1]);
       }
+      OOBLECK_UNROLL
       for (int j0 = 0; j0 < S; ++j0) {
         const double w0 = st.w[j0][0], dw0 = st.dw[j0][0], o0 = st.off[j0][0];
         const double P = mp * w0;  // m_p N_0
@@ -147,6 +155,7 @@ inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim
         const double E3 = w0 * fpt3 - dw0 * Vsig3[0], nB3 = -w0 * Vsig3[1];
         const V2 PV2(Vpres * dw0, Vpres * w0);
         const int row = st.index[j0][0];
+        OOBLECK_UNROLL
         for (int j1 = 0; j1 < S; ++j1) {
           const int i = row + st.index[j1][1];
           const double w1 = st.w[j1][1], dw1 = st.dw[j1][1];
@@ -223,13 +232,24 @@ inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim
 /// With `split_pressure` (the fluid phase) the stress is split as σ = τ − p 1 (p = −tr σ/3): the
 /// internal force gets only τ, the pressure part ∑ V_p p_p ∇N_ip goes to `pressure_force_N` for the
 /// buoyancy split (E28), and the nodal mixture volume ∑ N_ip V_p is accumulated.
-template <class G, int K>
-void particles_to_grid(const Body<G>& body, const ShapeCache<G::dim>& cache, GridField<G>& field, bool apic,
-                       bool split_pressure = false) {
-  constexpr int NC = G::ncomp;
+///
+/// The shape functions of the step (model.md §6 step 1) are computed here, point by point, with
+/// the same make_stencil as compute_shape_cache, and stored in `cache` for the rest of the step
+/// (contact, G2P): fused with the scatter, their latency overlaps its memory traffic. Returns the
+/// number of points whose support leaves the stored nodes (their scatter went to clamped nodes;
+/// the caller stops the run).
+template <class G, int K, class Kernel>
+std::int64_t particles_to_grid(const Body<G>& body, const Grid<G::dim>& grid, const Kernel& kernel,
+                               ShapeCache<G::dim>& cache, GridField<G>& field, bool apic, bool split_pressure = false) {
+  constexpr int NC = G::ncomp, S = support_of<G::dim>(K);
+  static_assert(Kernel::support == S);
   const std::int64_t np = body.size();
   const int nn = field.nodes();
+  cache.reserve(np, S);
+  cache.apic_by_gradient = Kernel::apic_by_gradient;
+  const StencilGrid<G::dim> sg(grid);
   int team = 1;
+  std::int64_t bad = 0;
 #pragma omp parallel num_threads(field.max_threads())
   {
     const int t = omp_get_thread_num();
@@ -254,9 +274,12 @@ void particles_to_grid(const Body<G>& body, const ShapeCache<G::dim>& cache, Gri
     double* mvd = mv->data();
     double* fd = f->data();
     double* fpd = fp->data();
-    auto scatter = [&]<bool A, bool S>() {
-#pragma omp for schedule(static)
-      for (std::int64_t p = 0; p < np; ++p) detail::particles_to_grid_point<G, K, A, S>(body, cache, p, m, mvd, fd, fpd, vol);
+    auto scatter = [&]<bool A, bool Sp>() {
+#pragma omp for schedule(static) reduction(+ : bad)
+      for (std::int64_t p = 0; p < np; ++p) {
+        if (!make_stencil(grid, sg, kernel, body.x_m[p], cache.template stencil<S>(p), cache.inv_D[p])) ++bad;
+        detail::particles_to_grid_point<G, K, A, Sp>(body, cache, p, m, mvd, fd, fpd, vol);
+      }
     };
     if (apic) {
       if (split_pressure) scatter.template operator()<true, true>();
@@ -280,6 +303,7 @@ void particles_to_grid(const Body<G>& body, const ShapeCache<G::dim>& cache, Gri
       }
     }
   }
+  return bad;
 }
 
 /// Body loads (model.md §6 step 3): gravity f_i += m_i g.
@@ -352,11 +376,13 @@ std::int64_t grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& c
         DW1[j1] = V2::Constant(st.dw[j1][1]);
         WO1[j1] = V2::Constant(st.w[j1][1] * st.off[j1][1]);
       }
+      OOBLECK_UNROLL
       for (int j0 = 0; j0 < S; ++j0) {
         const double w0 = st.w[j0][0], dw0 = st.dw[j0][0], o0 = st.off[j0][0];
         V2 t2 = V2::Zero(), tg2 = V2::Zero(), to2 = V2::Zero(), td2 = V2::Zero(), tq2 = V2::Zero();
         double t3 = 0.0, tg3 = 0.0, to3 = 0.0, td3 = 0.0, tq3 = 0.0, tn = 0.0, tqy = 0.0;
         const int row = st.index[j0][0];
+        OOBLECK_UNROLL
         for (int j1 = 0; j1 < S; ++j1) {
           const int i = row + st.index[j1][1];
           const double w1 = st.w[j1][1], dw1 = st.dw[j1][1];
