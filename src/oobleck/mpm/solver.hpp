@@ -331,7 +331,7 @@ class Solver {
     const auto& mx = opt_.mixture;
     const int nn = f.nodes();
     porosity_.resize(static_cast<std::size_t>(nn));
-#pragma omp parallel for schedule(static) if (nn >= kParallelMinNodes / 8)  // ~20 ns per node (drag)
+#pragma omp parallel for schedule(static) if (nn >= kParallelMinNodes / 32)  // ~20 ns per node (drag)
     for (int i = 0; i < nn; ++i) {
       const double V = f.volume_m3[i], ms = grains ? s.mass_kg[i] : 0.0, mf = f.mass_kg[i];
       double n = 1.0;

@@ -89,7 +89,7 @@ inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim
     Mat3 sig = body.stress_Pa[p];
     double Vpres = 0.0;
     if constexpr (Split) {
-      const double pres = -sig.trace() * (1.0 / 3.0);  // (a multiplication: off the critical path)
+      const double pres = -sig.trace() * (1.0 / 3.0);  // × 1/3, not ÷ 3: no division latency per point
       sig.diagonal().array() += pres;  // τ = σ + p 1
       Vpres = Vp * pres;
     }
@@ -442,43 +442,43 @@ std::int64_t grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& c
         (void)o0;
       }
     } else {
-    for_each_node<D, S>(cache.template stencil<S>(p), [&](int i, double w, const double* g, const double* off) {
-      const double* vi = vel + static_cast<std::int64_t>(i) * NC;
-      const V2 vi2 = Eigen::Map<const V2>(vi);
-      const double vi3 = NC == 3 ? vi[NC - 1] : 0.0;
-      if constexpr (Mixture) {
-        const double* qi = flux + static_cast<std::int64_t>(i) * NC;
-        n_p += w * porosity[i];
-        double d = qi[0] * g[0];
-        for (int a = 1; a < D; ++a) d += qi[a] * g[a];
-        div_q += d;
-        if constexpr (G::has_hoop_terms) {
-          q2 += w * Eigen::Map<const V2>(qi);
-          q3 += w * qi[2];
-        }
-      }
-      vp2 += w * vi2;
-      if constexpr (NC == 3) vp3 += w * vi3;
-      for (int a = 0; a < D; ++a) {
-        gv2[a] += vi2 * g[a];
-        if constexpr (NC == 3) gv3[a] += vi3 * g[a];
-      }
-      if constexpr (Apic) {
-        if constexpr (!ByGrad) {
-          const V2 wv2 = w * vi2;
-          const double wv3 = w * vi3;
-          for (int a = 0; a < D; ++a) {
-            B2[a] += wv2 * off[a];
-            if constexpr (NC == 3) B3[a] += wv3 * off[a];
+      for_each_node<D, S>(cache.template stencil<S>(p), [&](int i, double w, const double* g, const double* off) {
+        const double* vi = vel + static_cast<std::int64_t>(i) * NC;
+        const V2 vi2 = Eigen::Map<const V2>(vi);
+        const double vi3 = NC == 3 ? vi[NC - 1] : 0.0;
+        if constexpr (Mixture) {
+          const double* qi = flux + static_cast<std::int64_t>(i) * NC;
+          n_p += w * porosity[i];
+          double d = qi[0] * g[0];
+          for (int a = 1; a < D; ++a) d += qi[a] * g[a];
+          div_q += d;
+          if constexpr (G::has_hoop_terms) {
+            q2 += w * Eigen::Map<const V2>(qi);
+            q3 += w * qi[2];
           }
         }
-      } else {
-        const double* vo = vel_old + static_cast<std::int64_t>(i) * NC;
-        dv2 += w * (vi2 - Eigen::Map<const V2>(vo));
-        if constexpr (NC == 3) dv3 += w * (vi3 - vo[2]);
-      }
-      (void)off;
-    });
+        vp2 += w * vi2;
+        if constexpr (NC == 3) vp3 += w * vi3;
+        for (int a = 0; a < D; ++a) {
+          gv2[a] += vi2 * g[a];
+          if constexpr (NC == 3) gv3[a] += vi3 * g[a];
+        }
+        if constexpr (Apic) {
+          if constexpr (!ByGrad) {
+            const V2 wv2 = w * vi2;
+            const double wv3 = w * vi3;
+            for (int a = 0; a < D; ++a) {
+              B2[a] += wv2 * off[a];
+              if constexpr (NC == 3) B3[a] += wv3 * off[a];
+            }
+          }
+        } else {
+          const double* vo = vel_old + static_cast<std::int64_t>(i) * NC;
+          dv2 += w * (vi2 - Eigen::Map<const V2>(vo));
+          if constexpr (NC == 3) dv3 += w * (vi3 - vo[2]);
+        }
+        (void)off;
+      });
     }
     if constexpr (D == 2) {
       // The point's update written straight from the accumulators to its arrays, component by
