@@ -290,7 +290,7 @@ std::int64_t particles_to_grid(const Body<G>& body, const Grid<G::dim>& grid, co
     }
   }
   if (team > 1) {
-#pragma omp parallel for schedule(static) num_threads(team) if (nn >= kParallelMinNodes)
+#pragma omp parallel for schedule(static) num_threads(team) if (nn >= kParallelMinNodes / 8)  // ~5 ns per node and copy
     for (int i = 0; i < nn; ++i) {
       for (int t = 1; t < team; ++t) {
         field.mass_kg[i] += field.t_mass[t - 1][i];
