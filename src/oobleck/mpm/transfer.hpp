@@ -75,6 +75,21 @@ struct GridField {
 namespace detail {
 using V2 = Eigen::Matrix<double, 2, 1>;
 
+/// The second axis' factors of a 2D stencil for the factorised transfers, each in both SIMD
+/// lanes: per support node j1, N_1, N'_1 and N_1 o_1, and (N_1, N'_1) side by side.
+template <int S>
+struct SecondAxisFactors {
+  V2 w[S], dw[S], wo[S], w_dw[S];
+  explicit SecondAxisFactors(const Stencil<2, S>& st) {
+    for (int j1 = 0; j1 < S; ++j1) {
+      w_dw[j1] = V2(st.w[j1][1], st.dw[j1][1]);
+      w[j1] = V2::Constant(st.w[j1][1]);
+      dw[j1] = V2::Constant(st.dw[j1][1]);
+      wo[j1] = V2::Constant(st.w[j1][1] * st.off[j1][1]);
+    }
+  }
+};
+
 /// Scatter of point p (see particles_to_grid), with the APIC and
 /// split-pressure branches resolved at compile time and scalar per-point temporaries (no
 /// stack round trips of Eigen 3-vectors in the node loop). Arithmetic order per component is that
@@ -130,13 +145,7 @@ inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim
       // N_1 (a per-row value) + N'_1 or N_1 o_1 (another per-row value); the per-row values are
       // formed once for each of the S rows j0, so a node costs a few multiply-adds.
       const Stencil<D, S>& st = cache.template stencil<S>(p);
-      V2 W1[S], DW1[S], WO1[S], WD1[S];
-      for (int j1 = 0; j1 < S; ++j1) {
-        WD1[j1] = V2(st.w[j1][1], st.dw[j1][1]);
-        W1[j1] = V2::Constant(st.w[j1][1]);
-        DW1[j1] = V2::Constant(st.dw[j1][1]);
-        WO1[j1] = V2::Constant(st.w[j1][1] * st.off[j1][1]);
-      }
+      const SecondAxisFactors<S> a1(st);
       OOBLECK_UNROLL
       for (int j0 = 0; j0 < S; ++j0) {
         const double w0 = st.w[j0][0], dw0 = st.dw[j0][0], o0 = st.off[j0][0];
@@ -163,9 +172,9 @@ inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim
           double* fi = f + static_cast<std::int64_t>(i) * NC;
           m[i] += P * w1;
           Eigen::Map<V2> mvi2(mvi), fi2(fi);
-          if constexpr (Apic) mvi2 += W1[j1].cwiseProduct(U2) + WO1[j1].cwiseProduct(Vc2);
-          else mvi2 += W1[j1].cwiseProduct(U2);
-          fi2 += W1[j1].cwiseProduct(E2) + DW1[j1].cwiseProduct(nB2);
+          if constexpr (Apic) mvi2 += a1.w[j1].cwiseProduct(U2) + a1.wo[j1].cwiseProduct(Vc2);
+          else mvi2 += a1.w[j1].cwiseProduct(U2);
+          fi2 += a1.w[j1].cwiseProduct(E2) + a1.dw[j1].cwiseProduct(nB2);
           if constexpr (NC == 3) {
             if constexpr (Apic) mvi[2] += w1 * U3 + (w1 * st.off[j1][1]) * Vc3;
             else mvi[2] += w1 * U3;
@@ -173,7 +182,7 @@ inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim
           }
           if constexpr (Split) {
             double* fpi = fp + static_cast<std::int64_t>(i) * NC;
-            Eigen::Map<V2>(fpi) += PV2.cwiseProduct(WD1[j1]);  // V_p p (N'_0 N_1, N_0 N'_1)
+            Eigen::Map<V2>(fpi) += PV2.cwiseProduct(a1.w_dw[j1]);  // V_p p (N'_0 N_1, N_0 N'_1)
             if constexpr (G::has_hoop_terms)
               for (int c = 0; c < NC; ++c) fpi[c] += w1 * (w0 * fppt[c]);
             vol[i] += (w0 * Vp) * w1;
@@ -370,12 +379,7 @@ std::int64_t grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& c
       // N'_1 v_i and N_1 o_1 v_i, then ∑N v = ∑ N_0 (∑N_1 v), ∇: (∑ N'_0 (∑N_1 v), ∑ N_0 (∑N'_1 v)),
       // B = ∑N v (x_i − x_p)ᵀ = (∑ N_0 o_0 (∑N_1 v), ∑ N_0 (∑N_1 o_1 v)).
       const Stencil<D, S>& st = cache.template stencil<S>(p);
-      V2 W1[S], DW1[S], WO1[S];
-      for (int j1 = 0; j1 < S; ++j1) {
-        W1[j1] = V2::Constant(st.w[j1][1]);
-        DW1[j1] = V2::Constant(st.dw[j1][1]);
-        WO1[j1] = V2::Constant(st.w[j1][1] * st.off[j1][1]);
-      }
+      const SecondAxisFactors<S> a1(st);
       OOBLECK_UNROLL
       for (int j0 = 0; j0 < S; ++j0) {
         const double w0 = st.w[j0][0], dw0 = st.dw[j0][0], o0 = st.off[j0][0];
@@ -388,25 +392,25 @@ std::int64_t grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& c
           const double w1 = st.w[j1][1], dw1 = st.dw[j1][1];
           const double* vi = vel + static_cast<std::int64_t>(i) * NC;
           const V2 vi2 = Eigen::Map<const V2>(vi);
-          t2 += W1[j1].cwiseProduct(vi2);
-          tg2 += DW1[j1].cwiseProduct(vi2);
+          t2 += a1.w[j1].cwiseProduct(vi2);
+          tg2 += a1.dw[j1].cwiseProduct(vi2);
           if constexpr (NC == 3) {
             t3 += w1 * vi[2];
             tg3 += dw1 * vi[2];
           }
           if constexpr (Apic && !ByGrad) {
-            to2 += WO1[j1].cwiseProduct(vi2);
+            to2 += a1.wo[j1].cwiseProduct(vi2);
             if constexpr (NC == 3) to3 += (w1 * st.off[j1][1]) * vi[2];
           }
           if constexpr (!Apic) {
             const double* vo = vel_old + static_cast<std::int64_t>(i) * NC;
-            td2 += W1[j1].cwiseProduct(vi2 - Eigen::Map<const V2>(vo));
+            td2 += a1.w[j1].cwiseProduct(vi2 - Eigen::Map<const V2>(vo));
             if constexpr (NC == 3) td3 += w1 * (vi[2] - vo[2]);
           }
           if constexpr (Mixture) {
             const double* qi = flux + static_cast<std::int64_t>(i) * NC;
             tn += w1 * porosity[i];
-            tq2 += W1[j1].cwiseProduct(Eigen::Map<const V2>(qi));
+            tq2 += a1.w[j1].cwiseProduct(Eigen::Map<const V2>(qi));
             tqy += dw1 * qi[1];
             if constexpr (G::has_hoop_terms) tq3 += w1 * qi[2];
           }
