@@ -7,12 +7,13 @@
 #include <fmt/format.h>
 
 #include "cli_common.hpp"
+#include "oobleck/core/build_info.hpp"
 #include "oobleck/core/error.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"oobleck — dense suspension simulator (Baumgarten–Kamrin 2019 model)"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "oobleck 0.1.0");
+  app.set_version_flag("--version", oobleck::version_string());
   oobleck::cli::add_rheology_commands(app);
   oobleck::cli::add_point_commands(app);
   oobleck::cli::add_run_command(app);

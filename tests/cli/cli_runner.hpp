@@ -14,9 +14,10 @@ struct Result {
   std::string output;
 };
 
-inline Result run(const std::string& args) {
+/// Run `oobleck ARGS`; with a launcher, `LAUNCHER oobleck ARGS` (e.g. the dynamic loader).
+inline Result run(const std::string& args, const std::string& launcher = "") {
   Result r;
-  const std::string cmd = std::string(OOBLECK_CLI) + " " + args + " 2>&1";
+  const std::string cmd = (launcher.empty() ? "" : launcher + " ") + std::string(OOBLECK_CLI) + " " + args + " 2>&1";
   FILE* pipe = ::popen(cmd.c_str(), "r");
   if (pipe == nullptr) return r;
   std::array<char, 4096> buf{};

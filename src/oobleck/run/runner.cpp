@@ -14,6 +14,7 @@
 #include "oobleck/analysis/rod.hpp"
 #include "oobleck/analysis/wheel.hpp"
 #include "oobleck/analysis/summary_json.hpp"
+#include "oobleck/core/build_info.hpp"
 #include "oobleck/core/error.hpp"
 #include "oobleck/io/checkpoint.hpp"
 #include "oobleck/io/frames.hpp"
@@ -1267,6 +1268,7 @@ nlohmann::json SceneRun<G>::run() {
   j["wall_seconds"] = wall;
   j["point_updates_per_second"] = wall > 0 ? static_cast<double>(points) * static_cast<double>(steps_run) / wall : 0.0;
   j["threads"] = solver_->threads();
+  j["library_instruction_set"] = library_instruction_set();  // which CPU variant ran
   j["timings_seconds"] = {{"p2g", tm.p2g}, {"grid", tm.grid}, {"g2p", tm.g2p},
                           {"stress", tm.stress}, {"output_and_checks", wall - tm.total()}};
   j["parameters"] = parameters();
