@@ -83,6 +83,9 @@ TEST(PaperScenes, FastWheelRidesHigherAndTravelsFurtherThanTheSlowOne) {
   // S4 on a 50 x 25 grid for 1 s, same parameters, only omega changes (the coarse grid of
   // `reproduce --quick`): at 1 rad/s the wheel sinks below the bed surface and hardly moves; at
   // 10 rad/s the paddles jam the material they strike: it ends higher and travels forward.
+  // Δt = 2e-4 s: on this grid APIC's outcome depends on Δt (smaller steps lift both wheels; at
+  // 2e-5 s the slow one ends 2 cm above the surface), unlike at the paper's resolution
+  // (docs/results.md, S4 "Time step and transfer").
   clitest::TempDir d;
   const std::vector<std::string> coarse{"cells=[50,25]", "time.dt=2e-4", "duration=1.0"};
   auto with = [&](const std::string& omega) {
