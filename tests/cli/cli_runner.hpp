@@ -14,10 +14,10 @@ struct Result {
   std::string output;
 };
 
-/// Run `oobleck ARGS`; with a launcher, `LAUNCHER oobleck ARGS` (e.g. the dynamic loader).
-inline Result run(const std::string& args, const std::string& launcher = "") {
+/// Run a shell command: exit status and captured stdout+stderr.
+inline Result shell(const std::string& command) {
   Result r;
-  const std::string cmd = (launcher.empty() ? "" : launcher + " ") + std::string(OOBLECK_CLI) + " " + args + " 2>&1";
+  const std::string cmd = command + " 2>&1";
   FILE* pipe = ::popen(cmd.c_str(), "r");
   if (pipe == nullptr) return r;
   std::array<char, 4096> buf{};
@@ -26,6 +26,11 @@ inline Result run(const std::string& args, const std::string& launcher = "") {
   const int rc = ::pclose(pipe);
   r.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
   return r;
+}
+
+/// Run `oobleck ARGS`; with a launcher, `LAUNCHER oobleck ARGS` (e.g. the dynamic loader).
+inline Result run(const std::string& args, const std::string& launcher = "") {
+  return shell((launcher.empty() ? "" : launcher + " ") + std::string(OOBLECK_CLI) + " " + args);
 }
 
 /// A fresh, empty folder removed at the end of the test.

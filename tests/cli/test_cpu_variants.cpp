@@ -53,13 +53,9 @@ TEST(CpuVariants, BaselineLibraryRunsTheSceneOfTheBestVariantToRoundOff) {
   // The best built level the loader reports as supported on this CPU, else the baseline.
   std::string expected = "x86-64";
   {
-    FILE* p = ::popen((std::string(kLoader) + " --help 2>&1").c_str(), "r");
-    ASSERT_NE(p, nullptr);
-    std::string text;
-    char buf[4096];
-    std::size_t n = 0;
-    while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) text.append(buf, n);
-    ::pclose(p);
+    const auto help = clitest::shell(std::string(kLoader) + " --help");
+    ASSERT_EQ(help.status, 0) << help.output;
+    const std::string& text = help.output;
     const std::string built = OOBLECK_HWCAPS_LEVELS;
     for (const char* level : {"x86-64-v2", "x86-64-v3", "x86-64-v4"})
       if (built.find(level) != std::string::npos &&
