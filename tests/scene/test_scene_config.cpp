@@ -3,6 +3,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -117,12 +120,14 @@ TEST(SceneConfig, BenchmarkScenesLoadWithTheAuthorsPointCounts) {
 
 namespace {
 const std::string kIntrusion = std::string(OOBLECK_SOURCE_DIR) + "/scenes/paper/intrusion.toml";
-/// Error message of loading a copy of intrusion.toml with `from` replaced by `to`.
-std::string intrusion_error(const std::string& from, const std::string& to) {
+/// Error message of loading a copy of intrusion.toml with each `from` replaced by its `to`.
+std::string intrusion_error(const std::vector<std::pair<std::string, std::string>>& edits) {
   std::string s = read_all(kIntrusion);
-  const auto pos = s.find(from);
-  EXPECT_NE(pos, std::string::npos) << from;
-  s.replace(pos, from.size(), to);
+  for (const auto& [from, to] : edits) {
+    const auto pos = s.find(from);
+    EXPECT_NE(pos, std::string::npos) << from;
+    s.replace(pos, from.size(), to);
+  }
   const auto path = (std::filesystem::temp_directory_path() / "oobleck_body_test.toml").string();
   std::ofstream(path) << s;
   std::string msg;
@@ -134,6 +139,7 @@ std::string intrusion_error(const std::string& from, const std::string& to) {
   std::remove(path.c_str());
   return msg;
 }
+std::string intrusion_error(const std::string& from, const std::string& to) { return intrusion_error({{from, to}}); }
 }  // namespace
 
 TEST(SceneConfig, PaperScenesLoadWithTheirBodiesAndAliases) {
@@ -160,6 +166,10 @@ TEST(SceneConfig, BodyErrorsNameTheKeyAndRule) {
   EXPECT_NE(intrusion_error("max = [0.005, 0.035]", "max = [0.005, 0.045]").find("inside the grid"), std::string::npos);
   EXPECT_NE(intrusion_error("motion = \"prescribed\"", "motion = \"rigid\"").find("must be one of prescribed, free, elastic"), std::string::npos);
   EXPECT_NE(intrusion_error("friction = 0.3", "friction = 0.3\nmotor_omega = 3").find("only an elastic body"),
+            std::string::npos);
+  EXPECT_NE(intrusion_error("ramp_time = 0.0 ", "ramp_time = -0.001 ").find("body[0].ramp_time"), std::string::npos);
+  EXPECT_NE(intrusion_error({{"motion = \"prescribed\"", "motion = \"free\""}, {"ramp_time = 0.0 ", "ramp_time = 0.002 "}})
+                .find("only a prescribed body"),
             std::string::npos);
   EXPECT_NE(intrusion_error("kind = \"intrusion\"", "kind = \"intrusion\"\nbody = \"rod\"").find("no [[body]] has that name"),
             std::string::npos);

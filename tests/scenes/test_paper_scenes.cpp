@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -117,6 +118,30 @@ TEST(PaperScenes, FastWheelRidesHigherAndTravelsFurtherThanTheSlowOne) {
   }
   ASSERT_GT(n, 10);
   EXPECT_NEAR(sum / n, 10.0, 0.5);
+}
+
+TEST(PaperScenes, IntruderRampsUpToSpeedAlongTheClosedFormPath) {
+  // `ramp_time` T: the prescribed intruder starts from rest, v = v0 min(1, t/T), so its tip has
+  // moved v0 t^2/(2T) at t < T and v0 (t - T/2) after (a 2.5 mm grid, 2 ms into a 4 ms ramp and
+  // 1 ms past a 1 ms one). The velocity per step is taken at the step's midpoint, which makes
+  // the path exact while it ramps.
+  clitest::TempDir d;
+  const double v0 = 0.2, z0 = 0.0325;  // the box's centre, 30-35 mm
+  struct Case {
+    double ramp, duration;
+  };
+  for (const Case c : {Case{0.004, 0.002}, Case{0.001, 0.002}}) {
+    const auto s = run_paper_scene("intrusion.toml", d / "ramp",
+                                   {"cell_size=0.0025", fmt::format("duration={}", c.duration),
+                                    fmt::format("ramp_time={}", c.ramp)});
+    const double t = s["time"].get<double>();
+    const double expected = t < c.ramp ? v0 * t * t / (2 * c.ramp) : v0 * (t - 0.5 * c.ramp);
+    const auto& body = s["bodies"]["intruder"];
+    EXPECT_NEAR(z0 - body["centre"][1].get<double>(), expected, 1e-6 * expected) << c.ramp;
+    EXPECT_DOUBLE_EQ(body["ramp_time"].get<double>(), c.ramp);
+    const double v_end = v0 * std::min(1.0, (t - 0.5 * s["dt"].get<double>()) / c.ramp);  // last step's midpoint
+    EXPECT_NEAR(body["velocity"][1].get<double>(), -v_end, 1e-12) << c.ramp;
+  }
 }
 
 TEST(PaperScenes, IntruderDrivesAGrowingPlugWithFrontRatioNearTwo) {

@@ -1055,6 +1055,7 @@ nlohmann::json SceneRun<G>::body_analysis() const {
                             {"centre", std::vector<double>(c.data(), c.data() + D)},
                             {"velocity", std::vector<double>(v.data(), v.data() + NC)},
                             {"contact_force_last_step", std::vector<double>(F.data(), F.data() + NC)}};
+    if (tb.cfg->motion == scene::BodyMotionKind::Prescribed) bodies[tb.cfg->name]["ramp_time"] = tb.cfg->ramp_time_s;
   }
   out["bodies"] = bodies;
   if (analysed_ < 0 || track_.size() < 2) return out;
@@ -1078,8 +1079,9 @@ nlohmann::json SceneRun<G>::body_analysis() const {
     }
     analysis::FrontFitOptions fo;
     fo.wall_margin_m = 2.0 * h;
-    // The bed bottom is the longitudinal wall; fronts are fitted only after the tip entered the bed.
-    fo.t_begin_s = 0.0;
+    // The bed bottom is the longitudinal wall. k_l, k_t are defined at constant v_0: an intruder
+    // that ramps up to speed is fitted from the end of its ramp.
+    fo.t_begin_s = tb.cfg->ramp_time_s;
     auto fronts = [&](const std::vector<analysis::IntrusionFrame>& frames, const analysis::FrontCriterion& crit) {
       nlohmann::json j;
       const auto series = analysis::measure_front_series(frames, crit, geo, window);
@@ -1100,6 +1102,7 @@ nlohmann::json SceneRun<G>::body_analysis() const {
     for (const char* k : {"v_fl", "v_ft", "k_l", "k_t", "k_l_over_k_t"})
       out[k] = sp.is_null() ? nlohmann::json(nullptr) : sp[k];
     out["v0"] = std::fabs(v0);
+    out["ramp_time"] = tb.cfg->ramp_time_s;
     out["filter_window_frames"] = window;
     out["sample_interval"] = sample_dt;
   }
@@ -1233,6 +1236,9 @@ nlohmann::json SceneRun<G>::run() {
   solver_->reset_timings();
   const auto t0 = std::chrono::steady_clock::now();
   for (long s = first + 1; s <= last; ++s) {
+    for (const auto& tb : third_)  // prescribed bodies ramping up to speed
+      if (tb.cfg->ramp_time_s > 0.0)
+        solver_->set_prescribed_velocity(tb.body, prescribed_velocity<NC>(*tb.cfg, solver_->time_s(), dt_));
     solver_->step();
     check_finite();
     sample_analysis();

@@ -3,6 +3,7 @@
 // point lattices for boxes, discs and spoked wheels, the rigid/elastic motion, the contact pair
 // and the motor; plus the nodal averages of point fields that the scene analyses and snapshots
 // read (runner.cpp).
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -64,6 +65,17 @@ void body_bounds(const scene::BodyConfig& b, mpm::Vec<D>& lo, mpm::Vec<D>& hi) {
   }
 }
 
+/// Velocity of body `bc` over the step [t, t + Δt]: its `velocity`, scaled for a prescribed body
+/// with a `ramp_time` T by min(1, (t + Δt/2)/T) (the ramp at the step's midpoint, so the
+/// displacement follows v_0 t²/(2T) exactly while it ramps up).
+template <int NC>
+mpm::Vec<NC> prescribed_velocity(const scene::BodyConfig& bc, double t_s, double dt_s) {
+  mpm::Vec<NC> v;
+  for (int c = 0; c < NC; ++c) v[c] = bc.velocity_m_s[c];
+  if (bc.ramp_time_s > 0.0) v *= std::min(1.0, (t_s + 0.5 * dt_s) / bc.ramp_time_s);
+  return v;
+}
+
 /// Add body `bc` to the solver: points on a lattice of points_per_cell per axis inside its
 /// shape, its law (elastic) or rigid motion (prescribed, free), its contact pair with the
 /// mixture and its motor. Returns {body index, contact pair index}.
@@ -105,8 +117,7 @@ std::pair<int, int> add_third_body(mpm::Solver<G>& solver, const scene::BodyConf
                                  "(cell_size/points_per_cell = {} m)", file, bc.name, dx));
   }
   const double density = bc.mass_kg ? *bc.mass_kg / whole_volume : bc.density_kg_m3;
-  mpm::Vec<NC> v0;
-  for (int c = 0; c < NC; ++c) v0[c] = bc.velocity_m_s[c];
+  const mpm::Vec<NC> v0 = prescribed_velocity<NC>(bc, 0.0, 0.0);  // at rest when it ramps up
   const int index = solver.body_count();
   auto& body = solver.add_body(bc.name, mpm::Phase::Solid);
   if (bc.motion == scene::BodyMotionKind::Elastic) {

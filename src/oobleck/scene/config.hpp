@@ -92,6 +92,7 @@ struct BodyConfig {
   double angle_deg = 0.0;                                ///< [deg] angle of the first paddle from +x
   BodyMotionKind motion = BodyMotionKind::Prescribed;
   std::array<double, 3> velocity_m_s{0, 0, 0};           ///< [m/s] prescribed (or initial) velocity (scaled to `speed` when given)
+  double ramp_time_s = 0.0;                              ///< [s] prescribed: speed rises linearly from 0 to |velocity| over this time (0: full speed from t = 0)
   double density_kg_m3 = 0.0;                            ///< [kg/m^3]
   std::optional<double> mass_kg;                         ///< [kg] whole-body mass (rigid free bodies; sets the density)
   double youngs_modulus_Pa = 0.0;                        ///< [Pa] elastic bodies
