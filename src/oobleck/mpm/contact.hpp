@@ -3,7 +3,8 @@
 //
 // * Rigid bodies are ordinary material-point bodies (so they scatter a nodal mass field and a mass
 //   gradient for the contact normal) whose points move rigidly instead of following the grid:
-//     - Prescribed: every point moves at a fixed velocity v_0, every step, exactly (intruder);
+//     - Prescribed: every point moves at the body's velocity, every step, exactly (intruder; the
+//                   caller may change it between steps: a ramp up to speed);
 //     - FreeRigid:  translation only, V_{n+1} = V_n + Δt g + (Σ_i J_i)/M with J_i the contact
 //                   impulses the body received at its nodes (launched rod), the impulses solved
 //                   for the body as a whole (resolve_rigid_contact). Components whose

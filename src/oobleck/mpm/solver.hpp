@@ -116,8 +116,8 @@ class Solver {
 
   // ---- Third bodies and contact (model.md §8, contact.hpp) -------------------------------------
 
-  /// Make body b rigid, every point moving at v forever (intruder); the contact force on it is
-  /// the reaction the drive must supply.
+  /// Make body b rigid, every point moving at v until the next call (intruder; called before
+  /// each step to ramp it up); the contact force on it is the reaction the drive must supply.
   void set_prescribed_velocity(int b, const Vec<NC>& v) {
     check_solid(b, "prescribed velocity");
     rigid_[b].kind = BodyMotion::Prescribed;

@@ -1080,8 +1080,9 @@ nlohmann::json SceneRun<G>::body_analysis() const {
     analysis::FrontFitOptions fo;
     fo.wall_margin_m = 2.0 * h;
     // The bed bottom is the longitudinal wall. k_l, k_t are defined at constant v_0: an intruder
-    // that ramps up to speed is fitted from the end of its ramp.
-    fo.t_begin_s = tb.cfg->ramp_time_s;
+    // that ramps up to speed is fitted from the first sample whose (centred) time window lies
+    // after its ramp.
+    fo.t_begin_s = tb.cfg->ramp_time_s > 0 ? tb.cfg->ramp_time_s + 0.5 * static_cast<double>(window - 1) * sample_dt : 0.0;
     auto fronts = [&](const std::vector<analysis::IntrusionFrame>& frames, const analysis::FrontCriterion& crit) {
       nlohmann::json j;
       const auto series = analysis::measure_front_series(frames, crit, geo, window);

@@ -240,10 +240,10 @@ BodyConfig read_body(io::TomlReader& r, std::size_t index, const SceneConfig& c)
     if (!(n2 > 0)) r.fail("speed", "needs a non-zero `velocity` giving the direction of motion");
     for (double& v : b.velocity_m_s) v *= *speed / std::sqrt(n2);
   }
-  b.ramp_time_s = r.number_or("ramp_time", 0.0);
-  r.require(b.ramp_time_s >= 0, "ramp_time", b.ramp_time_s, "must be >= 0 [s]");
-  if (b.ramp_time_s > 0 && b.motion != BodyMotionKind::Prescribed)
+  if (r.has("ramp_time") && b.motion != BodyMotionKind::Prescribed)
     r.fail("ramp_time", "only a prescribed body (motion = \"prescribed\") takes a ramp_time");
+  b.ramp_time_s = r.number_or("ramp_time", 0.0);
+  r.require(b.ramp_time_s >= 0 && std::isfinite(b.ramp_time_s), "ramp_time", b.ramp_time_s, "must be >= 0 and finite [s]");
   b.points_per_cell = static_cast<int>(r.number_or("points_per_cell", 2));
   r.require(b.points_per_cell >= 1 && b.points_per_cell <= 8, "points_per_cell", b.points_per_cell,
             "must be an integer in [1, 8] (per axis)");
