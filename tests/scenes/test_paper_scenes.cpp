@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -23,6 +26,39 @@ nlohmann::json run_paper_scene(const std::string& scene, const std::string& out,
   o.quiet = true;
   o.threads = 1;
   return run::run_scene(scene::load_scene(std::string(OOBLECK_SOURCE_DIR) + "/scenes/paper/" + scene, sets), o);
+}
+
+/// Runs a paper scene once uninterrupted (into dir/full) and once stopped after `stop_after`
+/// steps and restarted (dir/part), one thread, checkpoints every `every` steps; returns both
+/// runs' last checkpoints.
+std::pair<io::Checkpoint, io::Checkpoint> run_and_restart(const std::string& scene, const std::vector<std::string>& sets,
+                                                          long every, long stop_after, const std::string& dir) {
+  const std::string file = std::string(OOBLECK_SOURCE_DIR) + "/scenes/paper/" + scene;
+  run::RunOptions o;
+  o.quiet = true;
+  o.threads = 1;
+  o.checkpoint_every = every;
+  o.out_dir = dir + "/full";
+  run::run_scene(scene::load_scene(file, sets), o);
+  o.out_dir = dir + "/part";
+  o.stop_after_steps = stop_after;
+  run::run_scene(scene::load_scene(file, sets), o);
+  o.stop_after_steps = -1;
+  o.restart = true;
+  run::run_scene(scene::load_scene(run::stored_scene_path(dir + "/part")), o);
+  return {io::read_checkpoint(run::checkpoint_path(dir + "/full")), io::read_checkpoint(run::checkpoint_path(dir + "/part"))};
+}
+
+/// Every state array of two checkpoints is bitwise equal.
+void expect_same_state(const io::Checkpoint& a, const io::Checkpoint& b) {
+  ASSERT_EQ(a.names(), b.names());
+  for (const auto& n : a.names()) {
+    if (n == "granular/regime") {
+      EXPECT_EQ(a.bytes(n), b.bytes(n));
+    } else {
+      EXPECT_EQ(a.doubles(n), b.doubles(n)) << n;
+    }
+  }
 }
 }  // namespace
 
@@ -147,6 +183,17 @@ TEST(PaperScenes, IntruderRampsUpToSpeedAlongTheClosedFormPath) {
   }
 }
 
+TEST(PaperScenes, RestartInsideTheRampContinuesBitForBit) {
+  // The ramped velocity is a function of the (checkpointed) time: stopping inside the ramp and
+  // restarting gives the uninterrupted run's state bit for bit.
+  clitest::TempDir d;
+  const auto [a, b] = run_and_restart("intrusion.toml", {"cell_size=0.0025", "duration=0.003", "ramp_time=0.004"},
+                                      200, 100, d / "ramp");
+  ASSERT_EQ(a.step(), b.step());
+  ASSERT_GE(a.step(), 200);
+  expect_same_state(a, b);
+}
+
 TEST(PaperScenes, IntruderDrivesAGrowingPlugWithFrontRatioNearTwo) {
   // S3 on a 2.5 mm grid for 10 ms (v0 = 0.2 m/s, phi = 0.47): material below the intruder moves
   // with it (u_z >= 0.5 v0) over a region that grows ahead of the tip and sideways past its edge.
@@ -207,33 +254,12 @@ TEST(PaperScenes, RodRunRestartsBitForBit) {
   // A free rigid body's velocity, its contact impulse sum and the analysis track are part of the
   // checkpoint: an interrupted rod run continues exactly.
   clitest::TempDir d;
-  const std::vector<std::string> sets = {"cell_size=0.005", "duration=0.002"};
-  run::RunOptions o;
-  o.quiet = true;
-  o.threads = 1;
-  o.checkpoint_every = 300;
-  o.out_dir = d / "full";
-  run::run_scene(scene::load_scene(std::string(OOBLECK_SOURCE_DIR) + "/scenes/paper/rod_impact.toml", sets), o);
-  o.out_dir = d / "part";
-  o.stop_after_steps = 150;
-  run::run_scene(scene::load_scene(std::string(OOBLECK_SOURCE_DIR) + "/scenes/paper/rod_impact.toml", sets), o);
-  o.stop_after_steps = -1;
-  o.restart = true;
-  run::run_scene(scene::load_scene(run::stored_scene_path(d / "part")), o);
-  const auto a = io::read_checkpoint(run::checkpoint_path(d / "full"));
-  const auto b = io::read_checkpoint(run::checkpoint_path(d / "part"));
+  const auto [a, b] = run_and_restart("rod_impact.toml", {"cell_size=0.005", "duration=0.002"}, 300, 150, d / "rod");
   ASSERT_EQ(a.step(), 300);
   ASSERT_EQ(b.step(), 300);
-  ASSERT_EQ(a.names(), b.names());
   EXPECT_TRUE(a.has("third0/rigid_velocity"));
   EXPECT_TRUE(a.has("analysis/track"));
-  for (const auto& n : a.names()) {
-    if (n == "granular/regime") {
-      EXPECT_EQ(a.bytes(n), b.bytes(n));
-    } else {
-      EXPECT_EQ(a.doubles(n), b.doubles(n)) << n;
-    }
-  }
+  expect_same_state(a, b);
 }
 
 TEST(PaperScenes, RestartedIntrusionReportsTheSameFronts) {
