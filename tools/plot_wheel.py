@@ -3,6 +3,7 @@
 spec S4), e.g. omega = 10 (fast) and omega = 1 (slow).
 
 usage: plot_wheel.py OUT_PREFIX RUN_FAST RUN_SLOW
+       plot_wheel.py --stiffness OUT_PNG RUN [RUN ...]
 writes OUT_PREFIX_track.png     hub height and distance travelled vs time for both runs, with the bed
                                 surface and surface -/+ wheel radius;
        OUT_PREFIX_fast.png      f at each snapshot of RUN_FAST with the phi = 0.1 free-surface contour
@@ -13,6 +14,13 @@ The grid is periodic in x; each field panel is shifted periodically to centre th
 unwrapped positions). The wheel outline is drawn rigid, at the hub position of series.csv, rotated by
 the integral of the measured mean angular velocity (an estimate: the wheel is elastic).
 A run without summary.json (still running) is read from series.csv and scene.toml instead.
+
+--stiffness: the SI's ringing figure. The granular pressure p~ of every grain point under the wheel
+(two radii either side of it, from three radii below to one above: the window of the run's
+`pressure_scatter`) in the HDF5 frame nearest t = 1 s of each run, e.g. runs of the fast wheel with
+the granular moduli G, K multiplied by 1, 10 and 100; each panel gives E = 9KG/(3K + G), the time
+step, and the within-cell scatter of p~ at the snapshot nearest 1 s from the run's summary.json
+(docs/analysis.md, "Wheel"). Needs h5py (Debian: python3-h5py).
 """
 import glob
 import math
@@ -244,6 +252,71 @@ def fig_pressure(runs, out):
     plt.close(fig)
 
 
+def frame_nearest(run, target):
+    """(time, path) of the HDF5 frame of `run` nearest `target` seconds."""
+    try:
+        import h5py
+    except ImportError:
+        raise SystemExit("plot_wheel.py --stiffness reads HDF5 frames: install h5py (Debian: python3-h5py)")
+    best = None
+    for path in glob.glob(os.path.join(run.path, "frames", "*.h5")):
+        with h5py.File(path, "r") as h5:
+            t = float(h5.attrs["time"])
+        if best is None or abs(t - target) < abs(best[0] - target):
+            best = (t, path)
+    if best is None:
+        raise SystemExit(f"{run.path}: no frames/*.h5 (the scene writes frames at [output] frame_interval)")
+    return best
+
+
+def fig_stiffness(runs, out, target=1.0):
+    import h5py
+
+    fig, axes = plt.subplots(1, len(runs), figsize=(5.2 * len(runs), 4.4), layout="constrained", squeeze=False)
+    for ax, r in zip(axes[0], runs):
+        t, path = frame_nearest(r, target)
+        with h5py.File(path, "r") as h5:
+            xg = h5["bodies/grains/position"][:]
+            pg = h5["bodies/grains/pressure"][:]
+            wheel = next((k for k in h5["bodies"] if k not in ("grains", "fluid")), None)
+            xw = h5[f"bodies/{wheel}/position"][:] if wheel else None
+        R = r.radius or 0.15
+        L = r.width
+        if xw is not None:  # the wheel's centre on the periodic track: circular mean of its points
+            a = 2 * math.pi * xw[:, 0] / L
+            xc = (math.atan2(np.mean(np.sin(a)), np.mean(np.cos(a))) * L / (2 * math.pi)) % L
+            yc = float(np.mean(xw[:, 1]))
+        else:
+            xc, yc, _ = r.hub_at(t)
+        dx = (xg[:, 0] - xc + L / 2) % L - L / 2
+        m = (np.abs(dx) <= 2 * R) & (xg[:, 1] >= yc - 3 * R) & (xg[:, 1] <= yc + R)
+        vmax = float(np.percentile(pg[m], 99)) * 1e-3 if np.any(m) else 1.0
+        sc = ax.scatter(dx[m], xg[m, 1], c=pg[m] * 1e-3, s=3, cmap="viridis", vmin=0.0, vmax=max(vmax, 1e-9),
+                        linewidths=0)
+        if xw is not None:
+            ax.scatter((xw[:, 0] - xc + L / 2) % L - L / 2, xw[:, 1], s=2, c="0.5", linewidths=0)
+        fig.colorbar(sc, ax=ax, shrink=0.85).set_label("p̃ [kPa] (to the 99th percentile)")
+        p = r.s.get("parameters", {})
+        Gm, Km = p.get("G"), p.get("K")
+        E = 9 * Km * Gm / (3 * Km + Gm) if isinstance(Gm, float) and isinstance(Km, float) else float("nan")
+        sc_rel = None
+        for rec in r.s.get("pressure_scatter", []) or []:
+            if sc_rel is None or abs(rec["time"] - target) < abs(sc_rel["time"] - target):
+                sc_rel = rec
+        note = (f"within-cell scatter {sc_rel['relative']:.2f} of rms {sc_rel['rms'] * 1e-3:.2g} kPa "
+                f"(t = {sc_rel['time']:.2f} s)" if sc_rel else "no pressure_scatter in summary.json")
+        ax.set_title(f"E = {E:.3g} Pa (G = {Gm:.3g}, K = {Km:.3g} Pa), Δt = {r.s.get('dt', float('nan')):.2g} s\n"
+                     f"t = {t:.2f} s; {note}", fontsize=8)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x − x_hub [m] (periodic)")
+        ax.set_ylabel("y [m]")
+        print(f"{r.path}: t = {t:.3f} s, E = {E:.3g} Pa, {note}")
+    fig.suptitle("SI: granular pressure under the wheel for three granular stiffnesses; "
+                 + run_title(runs[0].s).split(", ", 1)[1], fontsize=9)
+    fig.savefig(out, dpi=130, format="png")
+    plt.close(fig)
+
+
 def fig_track(runs, out):
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.6))
     for i, r in enumerate(runs):
@@ -277,6 +350,11 @@ def fig_track(runs, out):
 
 
 def main(argv):
+    if argv and argv[0] == "--stiffness":
+        if len(argv) < 3:
+            raise SystemExit(__doc__.strip())
+        fig_stiffness([Run(r) for r in argv[2:]], argv[1])
+        return
     if len(argv) != 3 or argv[0].startswith("-"):
         raise SystemExit(__doc__.strip())
     prefix, fast, slow = argv

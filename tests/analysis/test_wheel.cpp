@@ -108,3 +108,92 @@ TEST(Wheel, FreeSurfaceFromVolumeFraction) {
     }
   }
 }
+
+namespace {
+/// Points 2 × 2 per cell of size h (at h/4 and 3h/4 of each cell), cells [0, nx) × [0, ny) from
+/// the origin, with pressure p(x, y, sub) where sub = 0..3 numbers the point within its cell.
+template <class P>
+void cell_points(int nx, int ny, double h, P p, std::vector<double>& x, std::vector<double>& y,
+                 std::vector<double>& v) {
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i)
+      for (int b = 0; b < 2; ++b)
+        for (int a = 0; a < 2; ++a) {
+          const double px = (i + 0.25 + 0.5 * a) * h, py = (j + 0.25 + 0.5 * b) * h;
+          x.push_back(px);
+          y.push_back(py);
+          v.push_back(p(px, py, a + 2 * b));
+        }
+}
+ScatterWindow window(double x_centre, double half_width, double y_max, double cell, double period = 0.0) {
+  ScatterWindow w;
+  w.x_centre_m = x_centre;
+  w.half_width_m = half_width;
+  w.y_min_m = 0.0;
+  w.y_max_m = y_max;
+  w.cell_m = cell;
+  w.period_m = period;
+  return w;
+}
+}  // namespace
+
+TEST(Wheel, PressureScatterOfALinearFieldIsItsGradientAcrossACell) {
+  // p = p0 + gx x + gy y: each point deviates from its cell's mean (the centre value) by
+  // ±gx h/4 ± gy h/4, so the rms deviation is (h/4) sqrt(gx² + gy²) whatever p0.
+  const double h = 0.1, gx = 300.0, gy = -500.0;
+  std::vector<double> x, y, p;
+  cell_points(20, 10, h, [&](double px, double py, int) { return 4000.0 + gx * px + gy * py; }, x, y, p);
+  const ScatterWindow w = window(1.0, 1.0, 1.0, h);
+  const PressureScatter s = pressure_scatter(x, y, p, w);
+  EXPECT_EQ(s.points, 800);
+  EXPECT_EQ(s.cells, 200);
+  EXPECT_NEAR(s.rms_deviation_Pa, 0.25 * h * std::hypot(gx, gy), 1e-9);
+  double p2 = 0.0;
+  for (double v : p) p2 += v * v;
+  EXPECT_NEAR(s.rms_Pa, std::sqrt(p2 / 800.0), 1e-9);
+  EXPECT_NEAR(s.relative, s.rms_deviation_Pa / s.rms_Pa, 1e-15);
+}
+
+TEST(Wheel, PressureScatterOfPointToPointNoiseIsItsAmplitude) {
+  // The ringing pattern: p0 (1 ± eps) alternating from point to point within each cell, cell
+  // means p0 — relative scatter eps / sqrt(1 + eps²), independent of a smooth background.
+  const double h = 0.05, p0 = 2500.0, eps = 0.3;
+  std::vector<double> x, y, p;
+  cell_points(8, 6, h, [&](double, double, int sub) { return p0 * (1.0 + ((sub == 0 || sub == 3) ? eps : -eps)); },
+              x, y, p);
+  const ScatterWindow w = window(0.2, 0.2, 0.3, h);
+  const PressureScatter s = pressure_scatter(x, y, p, w);
+  EXPECT_NEAR(s.rms_deviation_Pa, eps * p0, 1e-9);
+  EXPECT_NEAR(s.relative, eps / std::sqrt(1.0 + eps * eps), 1e-12);
+}
+
+TEST(Wheel, PressureScatterWindowWrapsAroundThePeriodicTrack) {
+  // Track 2 m of 20 cells; a window centred on x = 0 reaches the last two columns through the
+  // seam: columns 18, 19, 0, 1 of 10 rows, 4 points each. A point alone in its cell is left out.
+  const double h = 0.1;
+  std::vector<double> x, y, p;
+  cell_points(20, 10, h, [](double px, double, int) { return px < 0.4 || px > 1.8 ? 100.0 : 1e6; }, x, y, p);
+  x.push_back(0.02);  // outside the grid rows above: its own cell (row 10)
+  y.push_back(1.02);
+  p.push_back(5e6);
+  ScatterWindow w = window(0.0, 0.2, 1.1, h, 2.0);
+  const PressureScatter s = pressure_scatter(x, y, p, w);
+  EXPECT_EQ(s.points, 160);
+  EXPECT_EQ(s.cells, 40);
+  EXPECT_DOUBLE_EQ(s.rms_Pa, 100.0);
+  EXPECT_DOUBLE_EQ(s.rms_deviation_Pa, 0.0);
+  w.period_m = 0.0;  // not periodic: only columns 0 and 1
+  EXPECT_EQ(pressure_scatter(x, y, p, w).points, 80);
+}
+
+TEST(Wheel, PressureScatterRejectsBadInput) {
+  const std::vector<double> a = {0.1, 0.2}, b = {0.1};
+  ScatterWindow w;
+  w.half_width_m = 1.0;
+  w.y_max_m = 1.0;
+  w.cell_m = 0.1;
+  EXPECT_THROW(pressure_scatter(a, b, a, w), InputError);
+  EXPECT_THROW(pressure_scatter(a, a, a, ScatterWindow{}), InputError);  // cell size 0
+  w.x_centre_m = 5.0;  // nothing in the window
+  EXPECT_THROW(pressure_scatter(a, a, a, w), InputError);
+}

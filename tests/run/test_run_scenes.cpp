@@ -134,12 +134,26 @@ TEST(RunScenes, InvalidScenesAreRefusedBeforeAnyOutput) {
     std::string t = text;
     t.replace(t.find(c.from), c.from.size(), c.to);
     std::ofstream(d / "bad.toml") << t;
-    const auto r = clitest::run("run " + d / "bad.toml" + " --out " + d / "out" + " --quiet");
+    const auto r = clitest::run("run " + d / "bad.toml" + " --out " + d / "new/out" + " --quiet");
     EXPECT_EQ(r.status, 2) << r.output;
     EXPECT_NE(r.output.find(c.message), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("bad.toml"), std::string::npos) << r.output;
-    EXPECT_FALSE(fs::exists(d / "out")) << c.message;
+    EXPECT_FALSE(fs::exists(d / "new")) << c.message;  // not even the missing parent folder
   }
+}
+
+TEST(RunScenes, RunFolderIsCreatedWithItsParents) {
+  // `--out out/NAME` in a fresh checkout (no out/ yet) runs; a file where a parent folder should
+  // be is an error naming it.
+  clitest::TempDir d;
+  const std::string scene = kScenes + "settling.toml";
+  const auto ok = clitest::run("run " + scene + " --out " + d / "a/b/run" + " --quiet --threads 1 --set time.duration=0.006");
+  EXPECT_EQ(ok.status, 0) << ok.output;
+  EXPECT_TRUE(fs::exists(d / "a/b/run/summary.json")) << ok.output;
+  std::ofstream(d / "file") << "x";
+  const auto bad = clitest::run("run " + scene + " --out " + d / "file/run" + " --quiet --threads 1 --set time.duration=0.006");
+  EXPECT_EQ(bad.status, 2) << bad.output;
+  EXPECT_NE(bad.output.find("cannot create the run folder"), std::string::npos) << bad.output;
 }
 
 // The guards fused into the step (G2P checks the new x, v, V; the elastic and fluid laws their new

@@ -154,6 +154,17 @@ TEST(PaperScenes, FastWheelRidesHigherAndTravelsFurtherThanTheSlowOne) {
   }
   ASSERT_GT(n, 10);
   EXPECT_NEAR(sum / n, 10.0, 0.5);
+  // The SI figure's measure: one pressure-scatter record per snapshot within the run (0.25, 0.5,
+  // 1 s), each over the grains under the wheel; a within-cell rms deviation never exceeds the rms.
+  const auto& ps = fast["pressure_scatter"];
+  ASSERT_EQ(ps.size(), 3u);
+  const double snap[3] = {0.25, 0.5, 1.0};
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_NEAR(ps[k]["time"].get<double>(), snap[k], 1e-3);
+    EXPECT_GT(ps[k]["points"].get<int>(), 200);  // window 4R x 4R = 0.36 m² of 40 mm cells, 4 points each
+    EXPECT_GE(ps[k]["relative"].get<double>(), 0.0);
+    EXPECT_LE(ps[k]["relative"].get<double>(), 1.0);
+  }
 }
 
 TEST(PaperScenes, IntruderRampsUpToSpeedAlongTheClosedFormPath) {

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -82,6 +84,54 @@ SurfaceProfile free_surface(const GridField2D& phi, double phi_threshold) {
     }
   }
   return p;
+}
+
+PressureScatter pressure_scatter(std::span<const double> x_m, std::span<const double> y_m,
+                                 std::span<const double> p_Pa, const ScatterWindow& w) {
+  if (x_m.size() != y_m.size() || x_m.size() != p_Pa.size())
+    throw InputError(fmt::format("pressure_scatter: {} x, {} y and {} pressure values differ in number", x_m.size(),
+                                 y_m.size(), p_Pa.size()));
+  if (!(w.cell_m > 0.0) || !std::isfinite(w.cell_m))
+    throw InputError(fmt::format("pressure_scatter: cell size {} must be positive", w.cell_m));
+  auto inside = [&](std::size_t k) {
+    double dx = x_m[k] - w.x_centre_m;
+    if (w.period_m > 0.0) dx -= w.period_m * std::round(dx / w.period_m);
+    return std::abs(dx) <= w.half_width_m && y_m[k] >= w.y_min_m && y_m[k] <= w.y_max_m && std::isfinite(p_Pa[k]);
+  };
+  auto cell = [&](std::size_t k) {
+    return std::pair<long, long>(static_cast<long>(std::floor((x_m[k] - w.origin_x_m) / w.cell_m)),
+                                 static_cast<long>(std::floor((y_m[k] - w.origin_y_m) / w.cell_m)));
+  };
+  struct Acc {
+    double sum = 0.0;
+    std::int64_t n = 0;
+  };
+  std::map<std::pair<long, long>, Acc> cells;  // ordered: the sums below do not depend on hashing
+  for (std::size_t k = 0; k < x_m.size(); ++k) {
+    if (!inside(k)) continue;
+    Acc& a = cells[cell(k)];
+    a.sum += p_Pa[k];
+    ++a.n;
+  }
+  PressureScatter r;
+  double dev2 = 0.0, p2 = 0.0;
+  for (std::size_t k = 0; k < x_m.size(); ++k) {
+    if (!inside(k)) continue;
+    const Acc& a = cells[cell(k)];
+    if (a.n < 2) continue;
+    const double d = p_Pa[k] - a.sum / static_cast<double>(a.n);
+    dev2 += d * d;
+    p2 += p_Pa[k] * p_Pa[k];
+    ++r.points;
+  }
+  for (const auto& [key, a] : cells) r.cells += a.n >= 2 ? 1 : 0;
+  if (r.points == 0)
+    throw InputError(fmt::format("pressure_scatter: no cell in the window (x {} ± {} m, y {}…{} m) holds two points",
+                                 w.x_centre_m, w.half_width_m, w.y_min_m, w.y_max_m));
+  r.rms_deviation_Pa = std::sqrt(dev2 / static_cast<double>(r.points));
+  r.rms_Pa = std::sqrt(p2 / static_cast<double>(r.points));
+  r.relative = r.rms_Pa > 0.0 ? r.rms_deviation_Pa / r.rms_Pa : 0.0;
+  return r;
 }
 
 }  // namespace oobleck::analysis

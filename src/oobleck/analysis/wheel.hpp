@@ -1,8 +1,11 @@
 #pragma once
 // S4 (running on oobleck, paper Figs. 11-12, scenes.md S4): hub height and distance travelled
 // across a periodic track, the "stays at the surface" / "sinks" verdicts, and the free-surface
-// height profile from a nodal volume-fraction field. See docs/analysis.md "Wheel".
+// height profile from a nodal volume-fraction field, and the point-to-point scatter of the granular
+// pressure under the wheel (the SI's ringing figure). See docs/analysis.md "Wheel".
 #include <cstddef>
+#include <cstdint>
+#include <span>
 #include <vector>
 
 #include "oobleck/analysis/data.hpp"
@@ -56,5 +59,31 @@ struct SurfaceProfile {
   std::vector<bool> has_material;
 };
 SurfaceProfile free_surface(const GridField2D& phi, double phi_threshold = 0.1);
+
+/// Where the pressure scatter is measured: points with |x − x_centre| <= half_width (the shortest
+/// periodic distance when period_m > 0) and y_min <= y <= y_max, binned into the grid's cells of
+/// size cell_m from (origin_x_m, origin_y_m).
+struct ScatterWindow {
+  double x_centre_m = 0.0, half_width_m = 0.0, y_min_m = 0.0, y_max_m = 0.0;
+  double origin_x_m = 0.0, origin_y_m = 0.0, cell_m = 0.0;
+  double period_m = 0.0;  ///< track length along x (0: not periodic)
+};
+
+/// Point-to-point scatter of a point field p (the granular pressure p~) within the grid cells:
+/// rms_deviation = sqrt(mean over points of (p − p̄_cell)²), p̄_cell the mean of the points in the
+/// same cell, rms = sqrt(mean of p²), relative = rms_deviation / rms. A smooth field gives only
+/// the variation of its gradient across a cell (|∇p| h/4 for a linear field sampled 2 × 2 per cell);
+/// the ringing instability of MPM (paper SI) is point-to-point noise that the grid does not see,
+/// which raises it towards 1. Points alone in their cell are not counted. Throws InputError for
+/// unequal sizes, a non-positive cell or an empty window.
+struct PressureScatter {
+  double relative = 0.0;
+  double rms_deviation_Pa = 0.0;
+  double rms_Pa = 0.0;
+  std::int64_t points = 0;  ///< counted points (in the window, sharing their cell with another)
+  std::int64_t cells = 0;   ///< cells with two or more points in the window
+};
+PressureScatter pressure_scatter(std::span<const double> x_m, std::span<const double> y_m,
+                                 std::span<const double> p_Pa, const ScatterWindow& window);
 
 }  // namespace oobleck::analysis

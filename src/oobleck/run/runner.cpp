@@ -126,6 +126,17 @@ class SceneRun {
   std::size_t next_snapshot_ = 0;
   std::vector<std::string> snapshot_files_;
   nlohmann::json rod_profile_;  ///< |dz| vs depth below the rod at the first snapshot (not checkpointed)
+  /// Wheel: point-to-point scatter of the granular pressure under the wheel at each snapshot (the
+  /// SI's ringing figure; analysis::pressure_scatter).
+  struct ScatterSample {
+    double t = 0.0;
+    analysis::PressureScatter s;
+  };
+  std::vector<ScatterSample> pressure_scatter_;
+  double wheel_radius(const ThirdBody& tb) const {
+    return tb.cfg->shape == scene::BodyShape::Disc ? tb.cfg->radius_m : tb.cfg->hub_radius_m + tb.cfg->paddle_length_m;
+  }
+  analysis::ScatterWindow scatter_window(const ThirdBody& tb) const;
   void build_bodies();
   void sample_track();
   void sample_intrusion_fields();
@@ -396,6 +407,25 @@ void SceneRun<G>::sample_intrusion_fields() {
 }
 
 template <class G>
+analysis::ScatterWindow SceneRun<G>::scatter_window(const ThirdBody& tb) const {
+  // Under the wheel: two radii either side of its centre of mass, from three radii below it to
+  // one above, on the grid's cells.
+  const auto& grid = solver_->grid();
+  const Vd c = centre_of_mass(solver_->body(tb.body), grid);
+  const double R = wheel_radius(tb);
+  analysis::ScatterWindow w;
+  w.x_centre_m = c[0];
+  w.half_width_m = 2.0 * R;
+  w.y_min_m = c[D - 1] - 3.0 * R;
+  w.y_max_m = c[D - 1] + R;
+  w.origin_x_m = grid.origin_m[0];
+  w.origin_y_m = grid.origin_m[D - 1];
+  w.cell_m = grid.h_m;
+  w.period_m = cfg_.boundary[0].type == scene::BoundaryType::Periodic ? cfg_.grid.size_m[0] : 0.0;
+  return w;
+}
+
+template <class G>
 void SceneRun<G>::write_due_snapshots(bool final_step) {
   if constexpr (D == 2) {
     const auto& times = cfg_.analysis.snapshot_times_s;
@@ -466,6 +496,23 @@ void SceneRun<G>::write_due_snapshots(bool final_step) {
           rod_profile_["rod_tip"] = tip;
         } catch (const InputError& e) {
           rod_profile_ = {{"note", e.what()}};
+        }
+      }
+      if (cfg_.analysis.kind == scene::AnalysisKind::Wheel && analysed_ >= 0 && grains_ >= 0) {
+        // SI figure: how smooth the point pressure p~ = -tr(sigma)/3 is under the wheel.
+        const auto& gb = solver_->body(grains_);
+        std::vector<double> px, py, pp;
+        for (std::int64_t p = 0; p < gb.size(); ++p) {
+          px.push_back(gb.x_m[p][0]);
+          py.push_back(gb.x_m[p][1]);
+          pp.push_back(-gb.stress_Pa[p].trace() / 3.0);
+        }
+        try {
+          pressure_scatter_.push_back(
+              {solver_->time_s(),
+               analysis::pressure_scatter(px, py, pp, scatter_window(third_[static_cast<std::size_t>(analysed_)]))});
+        } catch (const InputError&) {
+          // no grains under the wheel (e.g. a wheel started above the bed): nothing to report
         }
       }
       ++next_snapshot_;
@@ -672,6 +719,13 @@ void SceneRun<G>::write_checkpoint() const {
   }
   if (!x0_grains_.empty()) cp.array("analysis/x0_grains", as_doubles(x0_grains_));
   cp.attribute("next_snapshot", static_cast<std::int64_t>(next_snapshot_));
+  if (!pressure_scatter_.empty()) {
+    std::vector<double> flat;
+    for (const auto& r : pressure_scatter_)
+      flat.insert(flat.end(), {r.t, r.s.relative, r.s.rms_deviation_Pa, r.s.rms_Pa, static_cast<double>(r.s.points),
+                               static_cast<double>(r.s.cells)});
+    cp.array("analysis/pressure_scatter", flat);
+  }
   // Sampled nodal fields of the annular and intrusion analyses (all on the grid's nodes).
   auto save_fields = [&](const std::string& name, const auto& frames, auto field_of) {
     if (frames.empty()) return;
@@ -769,6 +823,19 @@ void SceneRun<G>::restore(const io::Checkpoint& cp) {
     }
   }
   for (std::size_t k = 0; k < next_snapshot_; ++k) snapshot_files_.push_back(fmt::format("snapshot_{}.csv", k));
+  if (cp.has("analysis/pressure_scatter")) {
+    const auto& flat = cp.doubles("analysis/pressure_scatter");
+    for (std::size_t o = 0; o + 6 <= flat.size(); o += 6) {
+      ScatterSample r;
+      r.t = flat[o];
+      r.s.relative = flat[o + 1];
+      r.s.rms_deviation_Pa = flat[o + 2];
+      r.s.rms_Pa = flat[o + 3];
+      r.s.points = static_cast<std::int64_t>(flat[o + 4]);
+      r.s.cells = static_cast<std::int64_t>(flat[o + 5]);
+      pressure_scatter_.push_back(r);
+    }
+  }
   if (cp.has("analysis/track")) {
     const auto& flat = cp.doubles("analysis/track");
     const std::size_t w = 4 + D + 2 * NC;
@@ -1164,8 +1231,7 @@ nlohmann::json SceneRun<G>::body_analysis() const {
     }
     analysis::WheelCriteria wc;
     wc.track_length_m = cfg_.grid.size_m[0];
-    wc.wheel_radius_m = tb.cfg->shape == scene::BodyShape::Disc ? tb.cfg->radius_m
-                                                                : tb.cfg->hub_radius_m + tb.cfg->paddle_length_m;
+    wc.wheel_radius_m = wheel_radius(tb);
     wc.bed_surface_m = bed_surface();
     double omega = tb.cfg->motor_omega_rad_s.value_or(0.0);
     wc.forward = omega > 0 ? -1.0 : 1.0;  // counter-clockwise rotation rolls towards -x
@@ -1184,13 +1250,28 @@ nlohmann::json SceneRun<G>::body_analysis() const {
     out["distance_travelled"] = analysis::to_json(dist);
     out["omega_measured"] = analysis::to_json(om);
     out["omega"] = omega;
+    nlohmann::json ps = nlohmann::json::array();
+    for (const auto& r : pressure_scatter_)
+      ps.push_back({{"time", r.t},
+                    {"relative", r.s.relative},
+                    {"rms_deviation", r.s.rms_deviation_Pa},
+                    {"rms", r.s.rms_Pa},
+                    {"points", r.s.points},
+                    {"cells", r.s.cells}});
+    out["pressure_scatter"] = ps;
   }
   return out;
 }
 
 template <class G>
 nlohmann::json SceneRun<G>::run() {
-  fs::create_directories(opt_.out_dir);
+  {
+    std::error_code ec;
+    fs::create_directories(opt_.out_dir, ec);
+    if (ec || !fs::is_directory(opt_.out_dir))
+      throw InputError(fmt::format("--out {}: cannot create the run folder: {}", opt_.out_dir,
+                                   ec ? ec.message() : "a file of that name is in the way"));
+  }
   const long every_frame = steps_between(cfg_.output.frame_interval_s, std::numeric_limits<long>::max());
   const long every_series = steps_between(cfg_.output.series_interval_s, 100);
   const long every_cp = opt_.checkpoint_every >= 0 ? opt_.checkpoint_every : cfg_.output.checkpoint_every;
