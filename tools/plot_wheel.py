@@ -19,8 +19,8 @@ A run without summary.json (still running) is read from series.csv and scene.tom
 (two radii either side of it, from three radii below to one above: the window of the run's
 `pressure_scatter`) in the HDF5 frame nearest t = 1 s of each run, e.g. runs of the fast wheel with
 the granular moduli G, K multiplied by 1, 10 and 100; each panel gives E = 9KG/(3K + G), the time
-step, and the within-cell scatter of p~ at the snapshot nearest 1 s from the run's summary.json
-(docs/analysis.md, "Wheel"). Needs h5py (Debian: python3-h5py).
+step, and the within-cell scatter of p~ (docs/analysis.md, "Wheel") at that frame and pooled over the
+run, from its summary.json; one colour scale for all panels. Needs h5py (Debian: python3-h5py).
 """
 import glob
 import math
@@ -272,46 +272,61 @@ def frame_nearest(run, target):
 def fig_stiffness(runs, out, target=1.0):
     import h5py
 
-    fig, axes = plt.subplots(1, len(runs), figsize=(5.2 * len(runs), 4.4), layout="constrained", squeeze=False)
-    for ax, r in zip(axes[0], runs):
+    panels = []
+    for r in runs:
         t, path = frame_nearest(r, target)
         with h5py.File(path, "r") as h5:
             xg = h5["bodies/grains/position"][:]
             pg = h5["bodies/grains/pressure"][:]
             wheel = next((k for k in h5["bodies"] if k not in ("grains", "fluid")), None)
             xw = h5[f"bodies/{wheel}/position"][:] if wheel else None
+            mw = h5[f"bodies/{wheel}/mass"][:] if wheel else None
         R = r.radius or 0.15
         L = r.width
-        if xw is not None:  # the wheel's centre on the periodic track: circular mean of its points
+        if xw is not None:  # the wheel's centre of mass on the periodic track (as the run's window)
             a = 2 * math.pi * xw[:, 0] / L
-            xc = (math.atan2(np.mean(np.sin(a)), np.mean(np.cos(a))) * L / (2 * math.pi)) % L
-            yc = float(np.mean(xw[:, 1]))
+            xc = (math.atan2(np.average(np.sin(a), weights=mw), np.average(np.cos(a), weights=mw)) * L
+                  / (2 * math.pi)) % L
+            yc = float(np.average(xw[:, 1], weights=mw))
         else:
             xc, yc, _ = r.hub_at(t)
+            xc %= L
         dx = (xg[:, 0] - xc + L / 2) % L - L / 2
         m = (np.abs(dx) <= 2 * R) & (xg[:, 1] >= yc - 3 * R) & (xg[:, 1] <= yc + R)
-        vmax = float(np.percentile(pg[m], 99)) * 1e-3 if np.any(m) else 1.0
-        sc = ax.scatter(dx[m], xg[m, 1], c=pg[m] * 1e-3, s=3, cmap="viridis", vmin=0.0, vmax=max(vmax, 1e-9),
-                        linewidths=0)
-        if xw is not None:
-            ax.scatter((xw[:, 0] - xc + L / 2) % L - L / 2, xw[:, 1], s=2, c="0.5", linewidths=0)
-        fig.colorbar(sc, ax=ax, shrink=0.85).set_label("p̃ [kPa] (to the 99th percentile)")
-        p = r.s.get("parameters", {})
-        Gm, Km = p.get("G"), p.get("K")
-        E = 9 * Km * Gm / (3 * Km + Gm) if isinstance(Gm, float) and isinstance(Km, float) else float("nan")
-        sc_rel = None
-        for rec in r.s.get("pressure_scatter", []) or []:
-            if sc_rel is None or abs(rec["time"] - target) < abs(sc_rel["time"] - target):
-                sc_rel = rec
-        note = (f"within-cell scatter {sc_rel['relative']:.2f} of rms {sc_rel['rms'] * 1e-3:.2g} kPa "
-                f"(t = {sc_rel['time']:.2f} s)" if sc_rel else "no pressure_scatter in summary.json")
-        ax.set_title(f"E = {E:.3g} Pa (G = {Gm:.3g}, K = {Km:.3g} Pa), Δt = {r.s.get('dt', float('nan')):.2g} s\n"
+        panels.append((r, t, dx[m], xg[m, 1], pg[m], None if xw is None else ((xw[:, 0] - xc + L / 2) % L - L / 2,
+                                                                              xw[:, 1])))
+    # one colour scale for all panels (the 99th percentile over all of them), so that the panels'
+    # pressure levels compare directly
+    allp = np.concatenate([pn[4] for pn in panels]) if panels else np.zeros(1)
+    vmax = max(float(np.percentile(allp, 99)) * 1e-3 if allp.size else 0.0, 1e-9)
+    fig, axes = plt.subplots(1, len(runs), figsize=(5.0 * len(runs) + 1.0, 4.4), layout="constrained", squeeze=False)
+    sc = None
+    for ax, (r, t, x, y, p, w) in zip(axes[0], panels):
+        sc = ax.scatter(x, y, c=p * 1e-3, s=3, cmap="viridis", vmin=0.0, vmax=vmax, linewidths=0)
+        if w is not None:
+            ax.scatter(w[0], w[1], s=2, c="0.5", linewidths=0)
+        prm = r.s.get("parameters", {})
+        Gm, Km = prm.get("G"), prm.get("K")
+        num = isinstance(Gm, (int, float)) and isinstance(Km, (int, float))
+        E = 9 * Km * Gm / (3 * Km + Gm) if num else float("nan")
+        moduli = f"G = {Gm:.3g}, K = {Km:.3g} Pa" if num else "G, K: see scene.toml"
+        pooled = (r.s.get("pressure_scatter") or {}).get("pooled")
+        near = None
+        for rec in (r.s.get("pressure_scatter") or {}).get("series", []):
+            if near is None or abs(rec["time"] - t) < abs(near["time"] - t):
+                near = rec
+        note = f"scatter {near['relative']:.2f} of rms {near['rms']:.3g} Pa here" if near else "no pressure_scatter"
+        if pooled and pooled.get("points"):
+            note += f"; pooled {pooled['relative']:.2f} (rms {pooled['rms']:.3g} Pa)"
+        dt = r.s.get("dt")
+        ax.set_title(f"E = {E:.3g} Pa ({moduli}), Δt = {dt if dt is not None else float('nan'):.2g} s\n"
                      f"t = {t:.2f} s; {note}", fontsize=8)
         ax.set_aspect("equal")
-        ax.set_xlabel("x − x_hub [m] (periodic)")
+        ax.set_xlabel("x − x_wheel [m] (periodic)")
         ax.set_ylabel("y [m]")
         print(f"{r.path}: t = {t:.3f} s, E = {E:.3g} Pa, {note}")
-    fig.suptitle("SI: granular pressure under the wheel for three granular stiffnesses; "
+    fig.colorbar(sc, ax=axes.ravel().tolist(), shrink=0.85).set_label("p̃ [kPa] (one scale: 99th percentile of all panels)")
+    fig.suptitle("SI: granular pressure of the grain points under the wheel for three granular stiffnesses; "
                  + run_title(runs[0].s).split(", ", 1)[1], fontsize=9)
     fig.savefig(out, dpi=130, format="png")
     plt.close(fig)

@@ -156,7 +156,7 @@ TEST(Wheel, PressureScatterOfALinearFieldIsItsGradientAcrossACell) {
 
 TEST(Wheel, PressureScatterOfPointToPointNoiseIsItsAmplitude) {
   // The ringing pattern: p0 (1 ± eps) alternating from point to point within each cell, cell
-  // means p0 — relative scatter eps / sqrt(1 + eps²), independent of a smooth background.
+  // means p0 — rms deviation eps p0, relative scatter eps / sqrt(1 + eps²).
   const double h = 0.05, p0 = 2500.0, eps = 0.3;
   std::vector<double> x, y, p;
   cell_points(8, 6, h, [&](double, double, int sub) { return p0 * (1.0 + ((sub == 0 || sub == 3) ? eps : -eps)); },
@@ -194,6 +194,31 @@ TEST(Wheel, PressureScatterRejectsBadInput) {
   w.cell_m = 0.1;
   EXPECT_THROW(pressure_scatter(a, b, a, w), InputError);
   EXPECT_THROW(pressure_scatter(a, a, a, ScatterWindow{}), InputError);  // cell size 0
-  w.x_centre_m = 5.0;  // nothing in the window
-  EXPECT_THROW(pressure_scatter(a, a, a, w), InputError);
+  const std::vector<double> pair = {0.11, 0.12}, p = {1.0, 3.0};
+  EXPECT_EQ(pressure_scatter(pair, pair, p, w).points, 2);  // two points in one cell
+  EXPECT_DOUBLE_EQ(pressure_scatter(pair, pair, p, w).rms_deviation_Pa, 1.0);
+  w.x_centre_m = 5.0;  // nothing in the window: no sample, not an error
+  EXPECT_EQ(pressure_scatter(pair, pair, p, w).points, 0);
+}
+
+TEST(Wheel, PooledPressureScatterWeighsEachSampleByItsPoints) {
+  // Two samples: 100 points with deviations 3 Pa around rms 10 Pa, 300 points with 1 Pa around
+  // 20 Pa: pooled rms deviation sqrt((100·9 + 300·1)/400), rms sqrt((100·100 + 300·400)/400).
+  PressureScatter a, b, empty;
+  a.points = 100;
+  a.cells = 25;
+  a.rms_deviation_Pa = 3.0;
+  a.rms_Pa = 10.0;
+  b.points = 300;
+  b.cells = 75;
+  b.rms_deviation_Pa = 1.0;
+  b.rms_Pa = 20.0;
+  const std::vector<PressureScatter> v = {a, empty, b};
+  const PressureScatter r = pool(v);
+  EXPECT_EQ(r.points, 400);
+  EXPECT_EQ(r.cells, 100);
+  EXPECT_DOUBLE_EQ(r.rms_deviation_Pa, std::sqrt(1200.0 / 400.0));
+  EXPECT_DOUBLE_EQ(r.rms_Pa, std::sqrt(130000.0 / 400.0));
+  EXPECT_DOUBLE_EQ(r.relative, std::sqrt(1200.0 / 130000.0));
+  EXPECT_EQ(pool(std::vector<PressureScatter>{}).points, 0);
 }

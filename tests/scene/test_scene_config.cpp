@@ -189,6 +189,9 @@ TEST(SceneConfig, EveryCommittedSceneFileLoads) {
 
 TEST(SceneConfig, BodyErrorsNameTheKeyAndRule) {
   EXPECT_NE(intrusion_error("density = 2700.0", "density = -1.0").find("body[0].density"), std::string::npos);
+  // Names become folders and HDF5 groups: refused at load time, before any output.
+  EXPECT_NE(intrusion_error("name = \"intruder\"", "name = \"my rod\"").find("body[0].name"), std::string::npos);
+  EXPECT_NE(intrusion_error("name = \"intrusion\"", "name = \"runs/intrusion\"").find("out/<name>"), std::string::npos);
   EXPECT_NE(intrusion_error("density = 2700.0", "mass = 1.0").find("only a free rigid body takes a mass"),
             std::string::npos);
   EXPECT_NE(intrusion_error("max = [0.005, 0.035]", "max = [0.005, 0.045]").find("inside the grid"), std::string::npos);

@@ -125,9 +125,25 @@ PressureScatter pressure_scatter(std::span<const double> x_m, std::span<const do
     ++r.points;
   }
   for (const auto& [key, a] : cells) r.cells += a.n >= 2 ? 1 : 0;
-  if (r.points == 0)
-    throw InputError(fmt::format("pressure_scatter: no cell in the window (x {} ± {} m, y {}…{} m) holds two points",
-                                 w.x_centre_m, w.half_width_m, w.y_min_m, w.y_max_m));
+  if (r.points == 0) return r;  // no cell in the window holds two points
+  r.rms_deviation_Pa = std::sqrt(dev2 / static_cast<double>(r.points));
+  r.rms_Pa = std::sqrt(p2 / static_cast<double>(r.points));
+  r.relative = r.rms_Pa > 0.0 ? r.rms_deviation_Pa / r.rms_Pa : 0.0;
+  return r;
+}
+
+PressureScatter pool(std::span<const PressureScatter> samples) {
+  PressureScatter r;
+  double dev2 = 0.0, p2 = 0.0;
+  for (const auto& s : samples) {
+    if (s.points <= 0) continue;
+    const auto n = static_cast<double>(s.points);
+    dev2 += n * s.rms_deviation_Pa * s.rms_deviation_Pa;
+    p2 += n * s.rms_Pa * s.rms_Pa;
+    r.points += s.points;
+    r.cells += s.cells;
+  }
+  if (r.points == 0) return r;
   r.rms_deviation_Pa = std::sqrt(dev2 / static_cast<double>(r.points));
   r.rms_Pa = std::sqrt(p2 / static_cast<double>(r.points));
   r.relative = r.rms_Pa > 0.0 ? r.rms_deviation_Pa / r.rms_Pa : 0.0;

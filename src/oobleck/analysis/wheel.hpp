@@ -71,11 +71,15 @@ struct ScatterWindow {
 
 /// Point-to-point scatter of a point field p (the granular pressure p~) within the grid cells:
 /// rms_deviation = sqrt(mean over points of (p − p̄_cell)²), p̄_cell the mean of the points in the
-/// same cell, rms = sqrt(mean of p²), relative = rms_deviation / rms. A smooth field gives only
-/// the variation of its gradient across a cell (|∇p| h/4 for a linear field sampled 2 × 2 per cell);
-/// the ringing instability of MPM (paper SI) is point-to-point noise that the grid does not see,
-/// which raises it towards 1. Points alone in their cell are not counted. Throws InputError for
-/// unequal sizes, a non-positive cell or an empty window.
+/// same cell, rms = sqrt(mean of p²) over the same points, relative = rms_deviation / rms ∈ [0, 1]
+/// (per cell Σ(p − p̄)² = Σp² − n p̄²). The deviation from the cell mean is the part of the field
+/// that a one-value-per-cell projection does not carry: for a smooth field only its variation
+/// across a cell (|∇p| h/4 for a linear field sampled 2 × 2 per cell), for point-to-point noise
+/// that cancels within each cell its full amplitude (ε p0 on a background p0). The ringing
+/// instability of MPM (paper SI) is such noise; a real jump inside a cell counts too, and
+/// `relative` is measured against the field itself (p~ = 0 is stress-free, so it has no arbitrary
+/// offset). Points alone in their cell are not counted; points = 0 when no cell in the window
+/// holds two. Throws InputError for unequal sizes or a non-positive cell.
 struct PressureScatter {
   double relative = 0.0;
   double rms_deviation_Pa = 0.0;
@@ -85,5 +89,9 @@ struct PressureScatter {
 };
 PressureScatter pressure_scatter(std::span<const double> x_m, std::span<const double> y_m,
                                  std::span<const double> p_Pa, const ScatterWindow& window);
+
+/// Several samples pooled: rms_deviation = sqrt(Σ n_k rms_deviation_k² / Σ n_k), rms likewise,
+/// relative their ratio, points and cells summed (samples with no points are skipped).
+PressureScatter pool(std::span<const PressureScatter> samples);
 
 }  // namespace oobleck::analysis

@@ -126,7 +126,7 @@ class SceneRun {
   std::size_t next_snapshot_ = 0;
   std::vector<std::string> snapshot_files_;
   nlohmann::json rod_profile_;  ///< |dz| vs depth below the rod at the first snapshot (not checkpointed)
-  /// Wheel: point-to-point scatter of the granular pressure under the wheel at each snapshot (the
+  /// Wheel: point-to-point scatter of the granular pressure under the wheel at each frame (the
   /// SI's ringing figure; analysis::pressure_scatter).
   struct ScatterSample {
     double t = 0.0;
@@ -137,6 +137,7 @@ class SceneRun {
     return tb.cfg->shape == scene::BodyShape::Disc ? tb.cfg->radius_m : tb.cfg->hub_radius_m + tb.cfg->paddle_length_m;
   }
   analysis::ScatterWindow scatter_window(const ThirdBody& tb) const;
+  void sample_pressure_scatter();
   void build_bodies();
   void sample_track();
   void sample_intrusion_fields();
@@ -426,6 +427,21 @@ analysis::ScatterWindow SceneRun<G>::scatter_window(const ThirdBody& tb) const {
 }
 
 template <class G>
+void SceneRun<G>::sample_pressure_scatter() {
+  if (cfg_.analysis.kind != scene::AnalysisKind::Wheel || analysed_ < 0 || grains_ < 0) return;
+  // SI figure: how smooth the point pressure p~ = -tr(sigma)/3 of the grains is under the wheel.
+  const auto& gb = solver_->body(grains_);
+  std::vector<double> px, py, pp;
+  for (std::int64_t p = 0; p < gb.size(); ++p) {
+    px.push_back(gb.x_m[p][0]);
+    py.push_back(gb.x_m[p][1]);
+    pp.push_back(-gb.stress_Pa[p].trace() / 3.0);
+  }
+  const auto r = analysis::pressure_scatter(px, py, pp, scatter_window(third_[static_cast<std::size_t>(analysed_)]));
+  if (r.points > 0) pressure_scatter_.push_back({solver_->time_s(), r});  // else no grains under the wheel
+}
+
+template <class G>
 void SceneRun<G>::write_due_snapshots(bool final_step) {
   if constexpr (D == 2) {
     const auto& times = cfg_.analysis.snapshot_times_s;
@@ -496,23 +512,6 @@ void SceneRun<G>::write_due_snapshots(bool final_step) {
           rod_profile_["rod_tip"] = tip;
         } catch (const InputError& e) {
           rod_profile_ = {{"note", e.what()}};
-        }
-      }
-      if (cfg_.analysis.kind == scene::AnalysisKind::Wheel && analysed_ >= 0 && grains_ >= 0) {
-        // SI figure: how smooth the point pressure p~ = -tr(sigma)/3 is under the wheel.
-        const auto& gb = solver_->body(grains_);
-        std::vector<double> px, py, pp;
-        for (std::int64_t p = 0; p < gb.size(); ++p) {
-          px.push_back(gb.x_m[p][0]);
-          py.push_back(gb.x_m[p][1]);
-          pp.push_back(-gb.stress_Pa[p].trace() / 3.0);
-        }
-        try {
-          pressure_scatter_.push_back(
-              {solver_->time_s(),
-               analysis::pressure_scatter(px, py, pp, scatter_window(third_[static_cast<std::size_t>(analysed_)]))});
-        } catch (const InputError&) {
-          // no grains under the wheel (e.g. a wheel started above the bed): nothing to report
         }
       }
       ++next_snapshot_;
@@ -622,6 +621,7 @@ void SceneRun<G>::write_frame(io::FrameWriter& frames) {
     frame.grid = std::move(ng);
   }
   frames.write(frame);
+  sample_pressure_scatter();
 }
 
 template <class G>
@@ -1250,15 +1250,20 @@ nlohmann::json SceneRun<G>::body_analysis() const {
     out["distance_travelled"] = analysis::to_json(dist);
     out["omega_measured"] = analysis::to_json(om);
     out["omega"] = omega;
-    nlohmann::json ps = nlohmann::json::array();
-    for (const auto& r : pressure_scatter_)
-      ps.push_back({{"time", r.t},
-                    {"relative", r.s.relative},
-                    {"rms_deviation", r.s.rms_deviation_Pa},
-                    {"rms", r.s.rms_Pa},
-                    {"points", r.s.points},
-                    {"cells", r.s.cells}});
-    out["pressure_scatter"] = ps;
+    // SI figure: the pressure scatter at every frame, and pooled over the frames after t = 0.
+    auto scatter_json = [](const analysis::PressureScatter& r) {
+      return nlohmann::json{{"relative", r.relative}, {"rms_deviation", r.rms_deviation_Pa}, {"rms", r.rms_Pa},
+                            {"points", r.points}, {"cells", r.cells}};
+    };
+    nlohmann::json series = nlohmann::json::array();
+    std::vector<analysis::PressureScatter> later;
+    for (const auto& r : pressure_scatter_) {
+      auto j = scatter_json(r.s);
+      j["time"] = r.t;
+      series.push_back(j);
+      if (r.t > 0.0) later.push_back(r.s);
+    }
+    out["pressure_scatter"] = {{"series", series}, {"pooled", scatter_json(analysis::pool(later))}};
   }
   return out;
 }
