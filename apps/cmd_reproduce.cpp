@@ -305,7 +305,8 @@ void wheel(Reproduction& r) {
                             "--set G={:g} --set K={:g}",
                             scene, r.out, name, t, q, dt, m * G, m * K),
                 fmt::format("SI pressure field, fast wheel with G and K x {}", m));
-      const auto& pooled = r.summary(name)["pressure_scatter"]["pooled"];
+      const nlohmann::json sum = r.summary(name);
+      const nlohmann::json& pooled = sum.at("pressure_scatter").at("pooled");
       scatter.push_back(pooled["relative"].get<double>());
       measured.push_back(fmt::format("x{}: {:.2f} (rms {:.2g} Pa)", m, scatter.back(), pooled["rms"].get<double>()));
       stiff.push_back(r.out + "/" + name);
