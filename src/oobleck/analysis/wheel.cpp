@@ -86,6 +86,16 @@ SurfaceProfile free_surface(const GridField2D& phi, double phi_threshold) {
   return p;
 }
 
+namespace {
+/// rms values and their ratio from the sums of squared deviations and of squared values over r.points.
+void finish_scatter(PressureScatter& r, double dev2, double p2) {
+  if (r.points == 0) return;
+  r.rms_deviation_Pa = std::sqrt(dev2 / static_cast<double>(r.points));
+  r.rms_Pa = std::sqrt(p2 / static_cast<double>(r.points));
+  r.relative = r.rms_Pa > 0.0 ? r.rms_deviation_Pa / r.rms_Pa : 0.0;
+}
+}  // namespace
+
 PressureScatter pressure_scatter(std::span<const double> x_m, std::span<const double> y_m,
                                  std::span<const double> p_Pa, const ScatterWindow& w) {
   if (x_m.size() != y_m.size() || x_m.size() != p_Pa.size())
@@ -125,10 +135,7 @@ PressureScatter pressure_scatter(std::span<const double> x_m, std::span<const do
     ++r.points;
   }
   for (const auto& [key, a] : cells) r.cells += a.n >= 2 ? 1 : 0;
-  if (r.points == 0) return r;  // no cell in the window holds two points
-  r.rms_deviation_Pa = std::sqrt(dev2 / static_cast<double>(r.points));
-  r.rms_Pa = std::sqrt(p2 / static_cast<double>(r.points));
-  r.relative = r.rms_Pa > 0.0 ? r.rms_deviation_Pa / r.rms_Pa : 0.0;
+  finish_scatter(r, dev2, p2);  // points = 0: no cell in the window holds two points
   return r;
 }
 
@@ -143,10 +150,7 @@ PressureScatter pool(std::span<const PressureScatter> samples) {
     r.points += s.points;
     r.cells += s.cells;
   }
-  if (r.points == 0) return r;
-  r.rms_deviation_Pa = std::sqrt(dev2 / static_cast<double>(r.points));
-  r.rms_Pa = std::sqrt(p2 / static_cast<double>(r.points));
-  r.relative = r.rms_Pa > 0.0 ? r.rms_deviation_Pa / r.rms_Pa : 0.0;
+  finish_scatter(r, dev2, p2);
   return r;
 }
 

@@ -36,17 +36,18 @@ int stored_components(FieldType type) {
   return 1;
 }
 
-namespace {
-
-void check_name(const std::string& name, const char* what) {
-  const bool ok = !name.empty() && name.size() <= 64 && std::all_of(name.begin(), name.end(), [](char c) {
+bool is_plain_name(const std::string& name) {
+  return !name.empty() && name.size() <= 64 && std::all_of(name.begin(), name.end(), [](char c) {
     return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
            c == '.';
   });
-  if (!ok) {
-    throw std::invalid_argument(
-        fmt::format("{} name '{}': use 1-64 characters of letters, digits, '_', '-', '.'", what, name));
-  }
+}
+
+namespace {
+
+void check_name(const std::string& name, const char* what) {
+  if (!is_plain_name(name))
+    throw std::invalid_argument(fmt::format("{} name '{}': {}", what, name, kPlainNameRule));
 }
 
 std::vector<std::span<const double>> spans(std::initializer_list<std::span<const double>> list) {

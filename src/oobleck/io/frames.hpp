@@ -41,6 +41,11 @@
 
 namespace oobleck::io {
 
+/// Names of bodies and fields become HDF5 groups and datasets (and scene names run folders):
+/// 1–64 letters, digits, '_', '-', '.'.
+bool is_plain_name(const std::string& name);
+inline constexpr const char* kPlainNameRule = "use 1-64 characters of letters, digits, '_', '-', '.'";
+
 /// XDMF attribute types. Vectors are stored with 3 components (2-component input gets a zero
 /// third component, which ParaView expects for glyphs and the Calculator); symmetric tensors
 /// with 6 in XDMF Tensor6 order (xx, xy, xz, yy, yz, zz); full tensors with 9, row-major

@@ -10,6 +10,7 @@
 #include <fmt/ranges.h>
 
 #include "oobleck/core/error.hpp"
+#include "oobleck/io/frames.hpp"
 #include "oobleck/io/toml_reader.hpp"
 
 namespace oobleck::scene {
@@ -175,16 +176,6 @@ constexpr std::array<std::pair<const char*, AnalysisKind>, 7> kAnalyses{{{"none"
                                                                         {"rod", AnalysisKind::Rod},
                                                                         {"wheel", AnalysisKind::Wheel}}};
 
-/// Scene and body names become folder, file and HDF5 group names (out/<scene>, frames'
-/// bodies/<body>): 1–64 letters, digits, '_', '-', '.'.
-bool is_plain_name(const std::string& name) {
-  return !name.empty() && name.size() <= 64 && std::all_of(name.begin(), name.end(), [](char ch) {
-    return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '_' || ch == '-' ||
-           ch == '.';
-  });
-}
-constexpr const char* kPlainName = "use 1-64 characters of letters, digits, '_', '-', '.'";
-
 /// One [[body]] table (model.md §8 bodies).
 BodyConfig read_body(io::TomlReader& r, std::size_t index, const SceneConfig& c) {
   const int dim = c.grid.dim;
@@ -195,7 +186,7 @@ BodyConfig read_body(io::TomlReader& r, std::size_t index, const SceneConfig& c)
     r.fail("name", fmt::format("= \"{}\": body names must be non-empty and differ from the phases \"grains\", \"fluid\"",
                                b.name));
   }
-  if (!is_plain_name(b.name)) r.fail("name", fmt::format("= \"{}\": {}", b.name, kPlainName));
+  if (!io::is_plain_name(b.name)) r.fail("name", fmt::format("= \"{}\": {}", b.name, io::kPlainNameRule));
   b.shape = parse_enum(r, "shape", BodyShape::Box, kBodyShapes);
   b.motion = parse_enum(r, "motion", BodyMotionKind::Prescribed, kMotions);
   auto inside_grid = [&](std::string_view key, double lo, double hi, int a) {
@@ -336,7 +327,8 @@ SceneConfig load_scene(const std::string& path, const std::vector<std::string>& 
 
   io::TomlReader sc = top.table("scene");
   c.name = sc.string("name");
-  if (!is_plain_name(c.name)) sc.fail("name", fmt::format("= \"{}\": {} (it names the run folder out/<name>)", c.name, kPlainName));
+  if (!io::is_plain_name(c.name))
+    sc.fail("name", fmt::format("= \"{}\": {} (it names the run folder out/<name>)", c.name, io::kPlainNameRule));
   c.description = sc.string_or("description", "");
   sc.finish();
 
