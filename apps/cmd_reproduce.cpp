@@ -111,6 +111,8 @@ void verification(Reproduction& r) {
                       std::max(std::fabs(Mi - M), std::fabs(Mo - M)) < 0.01 * M ? "within 1 %" : "within 3 % (coarse)"});
 }
 
+std::string num_or_nan(const nlohmann::json& j, const char* key, const char* fmtspec = "{:.3g}");
+
 void annular(Reproduction& r) {
   const std::string t = r.threads > 0 ? fmt::format(" --threads {}", r.threads) : "";
   const std::string q = r.quick ? " --set grid.cell_size=0.002" : "";
@@ -174,9 +176,25 @@ void annular(Reproduction& r) {
   }
   r.claims.push_back({"S1 slow bob (0.84 mm/s): profile vs Newtonian A r + B/r (L2 distance of v/u_i)",
                       "approaches A r + B/r", dists, worst < 0.05 ? "Newtonian (distance < 0.05)" : "OFF"});
+  // Why the two bob speeds differ, from the steady model alone (docs/analysis.md, steady_flow).
+  const auto& sf = s["steady_flow"];
+  const auto& sfs = slow["steady_flow"];
+  const bool fast_jams = !sf["steady_flow_possible"].get<bool>();
+  const bool slow_flows = sfs["steady_flow_possible"].get<bool>();
+  r.claims.push_back(
+      {"S1: the fast bob jams and the slow one flows (steady flow curve at the bed's phi)",
+       "fast: jams; slow: Newtonian-like flow",
+       fmt::format("fastest steady shear {} 1/s (DST rate {} 1/s): steady flow only for u_i <= {} mm/s; 84 mm/s: {}; "
+                   "0.84 mm/s: {}",
+                   num_or_nan(sf, "max_shear_rate"), num_or_nan(sf, "shear_rate_dst"),
+                   sf["bob_speed_limit"].is_number() ? fmt::format("{:.2f}", 1e3 * sf["bob_speed_limit"].get<double>())
+                                                     : std::string("any"),
+                   fast_jams ? "no steady state (the stress must keep growing)" : "a steady state exists",
+                   slow_flows ? "a steady state exists" : "no steady state"),
+       fast_jams && slow_flows ? "met (the model's prediction; see the two rows above for the runs)" : "OFF"});
 }
 
-std::string num_or_nan(const nlohmann::json& j, const char* key, const char* fmtspec = "{:.3g}") {
+std::string num_or_nan(const nlohmann::json& j, const char* key, const char* fmtspec) {
   return j.contains(key) && j[key].is_number() ? fmt::format(fmt::runtime(fmtspec), j[key].get<double>()) : "n/a";
 }
 

@@ -229,3 +229,25 @@ TEST(AnnularShear, RejectsBadInput) {
   EXPECT_THROW(surface_profiles({}, geometry(), {0.1}), InputError);
   EXPECT_THROW(front_speed({}, geometry()), InputError);
 }
+
+TEST(AnnularShear, SteadyBobSpeedLimitIsTheUniformShearProfile) {
+  // The flow that reaches the bound shears at the maximum rate everywhere:
+  // omega(r) = gamma (ln(r_o) - ln(r)), v = r omega, vanishing at the wall. Its bob speed, and
+  // its shear rate r |d omega/dr| by central differences, check the bound independently.
+  AnnularGeometry g;
+  g.bob_radius_m = 0.0125;
+  g.outer_radius_m = 0.0485;
+  const double gamma = 0.387;
+  const double limit = steady_bob_speed_limit(gamma, g);
+  auto omega = [&](double r) { return gamma * std::log(g.outer_radius_m / r); };
+  EXPECT_NEAR(limit, g.bob_radius_m * omega(g.bob_radius_m), 1e-15);
+  EXPECT_EQ(omega(g.outer_radius_m), 0.0);
+  for (double r = 0.013; r < 0.048; r += 0.005) {
+    const double h = 1e-6;
+    EXPECT_NEAR(r * std::fabs(omega(r + h) - omega(r - h)) / (2 * h), gamma, 1e-8);
+  }
+  EXPECT_THROW(steady_bob_speed_limit(0.0, g), InputError);
+  EXPECT_THROW(steady_bob_speed_limit(NAN, g), InputError);
+  g.outer_radius_m = g.bob_radius_m;
+  EXPECT_THROW(steady_bob_speed_limit(gamma, g), InputError);
+}

@@ -142,3 +142,74 @@ TEST(FlowCurve, PhiOutsideTheSteadyRangeIsRejected) {
   EXPECT_THROW(rheology::flow_curve(p.steady, 0.535, 10), InputError);
   EXPECT_THROW(rheology::flow_curve(p.steady, NAN, 10), InputError);
 }
+
+// The fastest steady shear (sup of gamma_dot over the flow curve) against a brute-force scan of
+// the closed-form E11 curve written out in paper_tables.hpp: the lower branch's turning point
+// where the curve is S-shaped, the E14 DST rate where the upper branch rises to it, no bound for
+// CST (phi < phi_c).
+TEST(FlowCurve, FastestSteadyShearIsTheSupremumOfTheClosedFormCurve) {
+  int humps = 0, asymptotes = 0;
+  for (const auto& fit : paper::fits()) {
+    if (fit.terms.empty() || fit.Delta != 0.0) continue;  // E11 closed form and E14 need finite eta_B, Delta = 0
+    const auto p = rheology::load_preset(fit.name);
+    for (double s : {0.05, 0.3, 0.6, 0.9}) {
+      const double phi = fit.phi_c + s * (fit.phi_j - fit.phi_c);
+      SCOPED_TRACE(fit.name + " phi=" + std::to_string(phi));
+      const double fu = paper::f_m(fit, phi);  // Delta = 0: f_u = f_m (phi_m(f_m) = phi)
+      double scan = 0.0, f_at = 0.0;
+      constexpr int n = 100000;
+      for (int k = 1; k < n; ++k) {
+        const double f = fu * k / n;
+        const double g = paper::gamma_dot_of_f(fit, phi, f);
+        if (g > scan) {
+          scan = g;
+          f_at = f;
+        }
+      }
+      const double dst = paper::gamma_dot_dst(fit, phi);
+      const auto lim = rheology::fastest_steady_shear(p.steady, phi);
+      ASSERT_TRUE(lim.has_value());
+      if (f_at < fu * (1.0 - 1e-3) && scan > dst) {  // an interior maximum: S-shaped curve
+        ++humps;
+        EXPECT_TRUE(lim->attained);
+        EXPECT_LT(rel(lim->shear_rate, scan), 1e-6);
+        EXPECT_NEAR(lim->f, f_at, 1e-3 * fu);
+        EXPECT_TRUE(std::isfinite(lim->shear_stress));
+      } else {  // rising to the DST asymptote
+        ++asymptotes;
+        EXPECT_FALSE(lim->attained);
+        EXPECT_LT(rel(lim->shear_rate, dst), 1e-12);
+        EXPECT_TRUE(std::isinf(lim->shear_stress));
+      }
+      EXPECT_GE(lim->shear_rate, dst * (1.0 - 1e-12));  // the sup is never below the asymptote
+    }
+    // CST: the flow curve has no upper bound in gamma_dot.
+    EXPECT_FALSE(rheology::fastest_steady_shear(p.steady, 0.9 * fit.phi_c).has_value());
+  }
+  EXPECT_GT(humps, 0);
+  EXPECT_GT(asymptotes, 0);
+  EXPECT_EQ(humps + asymptotes, 24);
+}
+
+// S1 (scenes.md): hermes2016 at the annular cell's phi = 0.505 with its eta_0 = 10 mPa s. The
+// curve is S-shaped: its lower branch turns (brute-force scan of the closed form) above the DST
+// rate, 0.255 1/s by hand from E14.
+TEST(FlowCurve, FastestSteadyShearOfTheAnnularCell) {
+  auto p = rheology::load_preset("hermes2016");
+  p.steady.eta_0 = 0.010;
+  paper::Fit fit = paper::fits().back();
+  ASSERT_EQ(fit.name, "hermes2016");
+  fit.eta_0 = 0.010;
+  const double phi = 0.505;
+  const double eta_B = 1.0 / (1.86e4 * std::pow(0.535 - phi, 4) + 9.3e-3 * std::pow(0.535 - phi, 0.1));
+  const double dst = 5.35 / 0.010 * std::pow(2 * 1.19 * std::pow(eta_B / 0.010 * 0.8 * phi / (0.535 - phi), 2), -1.0 / 3.0);
+  EXPECT_NEAR(dst, 0.255, 0.001);
+  double scan = 0.0;
+  const double fu = (phi - 0.535) / (0.436 - 0.535);
+  for (int k = 1; k < 100000; ++k) scan = std::max(scan, paper::gamma_dot_of_f(fit, phi, fu * k / 100000.0));
+  const auto lim = rheology::fastest_steady_shear(p.steady, phi);
+  ASSERT_TRUE(lim.has_value());
+  EXPECT_TRUE(lim->attained);
+  EXPECT_LT(rel(lim->shear_rate, scan), 1e-6);
+  EXPECT_GT(lim->shear_rate, 1.3 * dst);
+}

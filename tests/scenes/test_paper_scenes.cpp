@@ -87,6 +87,26 @@ TEST(PaperScenes, AnnularShearFastBobGrowsAJammedCoRotatingBand) {
   const auto r = s["front"]["value"].get<std::vector<double>>();
   EXPECT_GT(r.back() - r.front(), 0.008);
   EXPECT_GT(s["front_speed"].get<double>(), 2 * 0.084);
+  // No steady flow exists at this bob speed: the flow curve at phi 0.505 never shears faster than
+  // a few tenths of 1/s (at least the E14 DST rate, 0.255 1/s by hand), so steady Couette flow
+  // allows only a few mm/s at the bob (analysis::steady_bob_speed_limit).
+  const auto& sf = s["steady_flow"];
+  EXPECT_FALSE(sf["steady_flow_possible"].get<bool>());
+  EXPECT_NEAR(sf["shear_rate_dst"].get<double>(), 0.255, 0.001);
+  const double limit = sf["bob_speed_limit"].get<double>();
+  EXPECT_GE(limit, 0.255 * 0.0125 * std::log(0.0485 / 0.0125));
+  EXPECT_LT(limit, 0.084 / 10);
+}
+
+TEST(PaperScenes, AnnularShearSlowBobAdmitsASteadyFlow) {
+  // S1 at u_i = 0.84 mm/s: below the fastest steady flow of the bed (see the fast case above).
+  clitest::TempDir d;
+  const auto s = run_paper_scene("annular_shear.toml", d / "run",
+                                 {"grid.cell_size=0.002", "duration=0.01", "u_inner=0.00084"});
+  const auto& sf = s["steady_flow"];
+  EXPECT_TRUE(sf["steady_flow_possible"].get<bool>());
+  EXPECT_GT(sf["bob_speed_limit"].get<double>(), 0.00084);
+  EXPECT_NEAR(sf["bob_speed"].get<double>(), 0.00084, 1e-15);
 }
 
 TEST(PaperScenes, AnnularShearBandIsDraggedOutThenReleased) {

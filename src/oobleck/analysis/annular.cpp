@@ -333,4 +333,13 @@ OuterArrest outer_arrest(const TimeSeries& outer_rotation, double fraction) {
   return a;
 }
 
+double steady_bob_speed_limit(double max_shear_rate_1_s, const AnnularGeometry& geometry) {
+  if (!(std::isfinite(max_shear_rate_1_s) && max_shear_rate_1_s > 0.0))
+    throw InputError(fmt::format("steady_bob_speed_limit: shear rate = {} must be positive [1/s]", max_shear_rate_1_s));
+  const double r0 = geometry.bob_radius_m, ro = geometry.outer_radius_m;
+  if (!(r0 > 0.0 && ro > r0))
+    throw InputError(fmt::format("steady_bob_speed_limit: radii r_0 = {}, r_o = {} [m]: need 0 < r_0 < r_o", r0, ro));
+  return max_shear_rate_1_s * r0 * std::log(ro / r0);
+}
+
 }  // namespace oobleck::analysis

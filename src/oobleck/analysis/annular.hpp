@@ -134,4 +134,12 @@ struct OuterArrest {
 };
 OuterArrest outer_arrest(const TimeSeries& outer_rotation, double fraction = 0.1);
 
+/// The fastest bob speed [m/s] that admits a steady flow when no material point can shear
+/// steadily faster than `max_shear_rate_1_s` (rheology::fastest_steady_shear at the bed's phi):
+/// in a steady annular flow v_theta = r omega(r), the shear rate is gamma_dot = r |d omega/dr|,
+/// so along any radial line omega_bob = integral of gamma_dot/r dr <= max_shear_rate ln(r_o/r_0),
+/// i.e. u_i <= max_shear_rate r_0 ln(r_o/r_0). A faster bob has no steady state: the stress must
+/// keep growing while it turns. Throws InputError for a non-positive rate or r_o <= r_0.
+double steady_bob_speed_limit(double max_shear_rate_1_s, const AnnularGeometry& geometry);
+
 }  // namespace oobleck::analysis

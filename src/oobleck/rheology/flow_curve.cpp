@@ -117,4 +117,57 @@ std::optional<double> shear_rate_dst(const SteadyParams& p, double phi, std::str
   return p.tau_star / p.eta_0 / std::cbrt(2.0 * p.mu_c * r * r);  // E14
 }
 
+std::optional<SteadyShearLimit> fastest_steady_shear(const SteadyParams& p, double phi) {
+  validate_phi(p, phi, "phi");
+  const double fu = f_upper(p, phi);
+  // The flow curve in the logistic coordinate x of flow_curve (f/f_u = 1/(1 + e^-x)), so that
+  // states next to f_u keep their gap f_u - f without cancellation.
+  constexpr double kEnd = 1e-10;
+  const double x_max = std::log((1.0 - kEnd) / kEnd);
+  auto rate = [&](double x) {
+    return steady_point(p, phi, fu / (1.0 + std::exp(-x)), fu / (1.0 + std::exp(x))).shear_rate;
+  };
+  constexpr int kSamples = 2000;
+  const double dx = 2.0 * x_max / (kSamples - 1);
+  int best = 0;
+  double best_rate = -1.0;
+  for (int k = 0; k < kSamples; ++k) {
+    const double g = rate(-x_max + dx * k);
+    if (g > best_rate) {
+      best_rate = g;
+      best = k;
+    }
+  }
+  if (best == kSamples - 1) {
+    // Rising to the end of the sweep: the DST asymptote (finite) or no bound at all.
+    const auto dst = shear_rate_dst(p, phi);
+    if (!dst) return std::nullopt;
+    return SteadyShearLimit{*dst, INFINITY, fu, false};
+  }
+  // Golden-section refinement of the sampled maximum (gamma_dot is smooth in x and has a single
+  // hump between the neighbouring samples).
+  const double inv_phi = 0.5 * (std::sqrt(5.0) - 1.0);
+  double lo = -x_max + dx * std::max(best - 1, 0), hi = -x_max + dx * std::min(best + 1, kSamples - 1);
+  double x1 = hi - inv_phi * (hi - lo), x2 = lo + inv_phi * (hi - lo);
+  double g1 = rate(x1), g2 = rate(x2);
+  while (hi - lo > 1e-12 * std::max(1.0, std::fabs(hi))) {
+    if (g1 < g2) {
+      lo = x1;
+      x1 = x2;
+      g1 = g2;
+      x2 = lo + inv_phi * (hi - lo);
+      g2 = rate(x2);
+    } else {
+      hi = x2;
+      x2 = x1;
+      g2 = g1;
+      x1 = hi - inv_phi * (hi - lo);
+      g1 = rate(x1);
+    }
+  }
+  const double x = 0.5 * (lo + hi);
+  const SteadyPoint s = steady_point(p, phi, fu / (1.0 + std::exp(-x)), fu / (1.0 + std::exp(x)));
+  return SteadyShearLimit{s.shear_rate, s.shear_stress, s.f, true};
+}
+
 }  // namespace oobleck::rheology

@@ -46,4 +46,21 @@ double eta_r_high(const SteadyParams& p, double phi);
 /// does not apply (then `reason`, if given, says why).
 std::optional<double> shear_rate_dst(const SteadyParams& p, double phi, std::string* reason = nullptr);
 
+/// The fastest steady simple shear at phi: the supremum of gamma_dot over every branch of the
+/// flow curve (E11). On an S-shaped curve it is the lower branch's turning point (attained at a
+/// finite stress); where the upper branch rises monotonically to the DST asymptote (E14) it is
+/// gamma_dot_DST, approached as the stress diverges (`attained` false, `shear_stress` infinite).
+/// Above it no steady homogeneous flow exists at this phi: a flow driven faster must keep
+/// loading (the stress grows without bound while phi stays fixed).
+struct SteadyShearLimit {
+  double shear_rate = 0.0;    ///< sup gamma_dot [1/s]
+  double shear_stress = 0.0;  ///< mixture tau at the supremum [Pa] (infinite when not attained)
+  double f = 0.0;             ///< structure at the supremum
+  bool attained = true;       ///< false: the DST asymptote, reached only as tau -> infinity
+};
+
+/// nullopt where the flow curve is unbounded in gamma_dot (phi < phi_c: CST, any rate flows;
+/// phi > phi* with f_m capped below f_jam). Throws InputError unless 0 < phi < phi_j.
+std::optional<SteadyShearLimit> fastest_steady_shear(const SteadyParams& p, double phi);
+
 }  // namespace oobleck::rheology

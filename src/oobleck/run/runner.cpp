@@ -29,6 +29,7 @@
 #include "oobleck/mpm/laws.hpp"
 #include "oobleck/mpm/solver.hpp"
 #include "oobleck/rheology/f_max.hpp"
+#include "oobleck/rheology/flow_curve.hpp"
 #include "oobleck/run/finite_check.hpp"
 #include "oobleck/run/third_bodies.hpp"
 
@@ -1055,6 +1056,37 @@ nlohmann::json SceneRun<G>::analysis_result() const {
     const auto outer = analysis::outer_rotation_series(shear_frames_, geo);
     a["outer_rotation"] = analysis::to_json(outer);
     a["outer_arrest"] = analysis::to_json(analysis::outer_arrest(outer, 0.1));
+    // Whether the bob's speed admits any steady flow of the bed (docs/analysis.md "Annular
+    // shear"): the fastest steady shear of the flow curve at the bed's phi and the bob speed it allows.
+    {
+      nlohmann::json sf;
+      const double phi = cfg_.regions.front().phi;
+      sf["phi"] = phi;
+      std::optional<rheology::SteadyShearLimit> lim;
+      try {
+        lim = rheology::fastest_steady_shear(cfg_.material.steady, phi);
+      } catch (const InputError& e) {  // phi >= phi_j: jammed, no steady flow at any speed
+        sf["note"] = e.what();
+      }
+      const auto dst = rheology::shear_rate_dst(cfg_.material.steady, phi);
+      sf["shear_rate_dst"] = dst ? nlohmann::json(*dst) : nlohmann::json(nullptr);
+      sf["bob_speed"] = geo.bob_speed_m_per_s;
+      if (lim) {
+        sf["max_shear_rate"] = lim->shear_rate;
+        sf["max_shear_rate_stress"] = lim->attained ? nlohmann::json(lim->shear_stress) : nlohmann::json(nullptr);
+        sf["max_shear_rate_is_dst_asymptote"] = !lim->attained;
+        const double limit = analysis::steady_bob_speed_limit(lim->shear_rate, geo);
+        sf["bob_speed_limit"] = limit;
+        sf["steady_flow_possible"] = std::fabs(geo.bob_speed_m_per_s) <= limit;
+      } else {
+        // Unbounded flow curve (CST): every bob speed has a steady state; jammed bed: none.
+        const bool jammed = sf.contains("note");
+        sf["max_shear_rate"] = jammed ? nlohmann::json(0.0) : nlohmann::json(nullptr);
+        sf["bob_speed_limit"] = jammed ? nlohmann::json(0.0) : nlohmann::json(nullptr);
+        sf["steady_flow_possible"] = !jammed;
+      }
+      a["steady_flow"] = sf;
+    }
     // How far the jammed structure has spread: f >= half its E9 limit f_m(phi) of the bed.
     if (!shear_frames_.front().f.values.empty()) {
       const double f_thr = 0.5 * rheology::f_m(cfg_.material.steady, cfg_.regions.front().phi);
