@@ -73,22 +73,39 @@ void dst_command(CLI::App& rheology) {
   auto o = std::make_shared<Opts>();
   o->params.add_to(cmd);
   cmd->add_option("--phi", o->phi, "volume fraction")->required();
-  cmd->add_flag("--json", o->json, "print one JSON object {\"phi\", \"shear_rate_dst\"}");
+  cmd->add_flag("--json", o->json,
+                "print one JSON object {\"phi\", \"shear_rate_dst\", \"max_shear_rate\", \"max_shear_rate_stress\"}");
   cmd->callback([o] {
     const rheology::Preset p = o->params.load();
     rheology::validate_phi(p.steady, o->phi, fmt::format("--phi (parameters: {})", p.file));
     std::string reason;
     const auto rate = rheology::shear_rate_dst(p.steady, o->phi, &reason);
+    // The fastest steady shear of the whole flow curve (null: unbounded, CST).
+    const auto fastest = rheology::fastest_steady_shear(p.steady, o->phi);
     if (o->json) {
       nlohmann::json j;
       j["phi"] = o->phi;
       j["shear_rate_dst"] = rate ? nlohmann::json(*rate) : nlohmann::json(nullptr);
       if (!rate) j["reason"] = reason;
+      j["max_shear_rate"] = fastest ? nlohmann::json(fastest->shear_rate) : nlohmann::json(nullptr);
+      j["max_shear_rate_stress"] =
+          fastest && fastest->attained ? nlohmann::json(fastest->shear_stress) : nlohmann::json(nullptr);
       fmt::print("{}\n", j.dump());
-    } else if (rate) {
+      return;
+    }
+    if (rate) {
       fmt::print("gamma_dot_DST = {:.6g} 1/s  ({} at phi = {})\n", *rate, p.name, o->phi);
     } else {
       fmt::print("no DST at phi = {} for {}: {}\n", o->phi, p.name, reason);
+    }
+    if (!fastest) {
+      fmt::print("fastest steady shear: unbounded (the flow curve rises without limit)\n");
+    } else if (fastest->attained) {
+      fmt::print("fastest steady shear = {:.6g} 1/s at tau = {:.4g} Pa (where the lower branch turns back); no "
+                 "steady flow is faster\n",
+                 fastest->shear_rate, fastest->shear_stress);
+    } else {
+      fmt::print("fastest steady shear = gamma_dot_DST, approached as the stress diverges; no steady flow is faster\n");
     }
   });
 }

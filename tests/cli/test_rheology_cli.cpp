@@ -52,10 +52,14 @@ TEST(RheologyCli, DstJsonShape) {
   auto j = nlohmann::json::parse(r.output);
   EXPECT_DOUBLE_EQ(j["phi"].get<double>(), 0.45);
   EXPECT_GT(j["shear_rate_dst"].get<double>(), 0.0);
+  // The fastest steady shear is never below the DST asymptote.
+  EXPECT_GE(j["max_shear_rate"].get<double>(), j["shear_rate_dst"].get<double>() * (1 - 1e-12));
   r = run("rheology dst --preset hermes2016 --phi 0.40 --json");  // CST: DST does not apply
   ASSERT_EQ(r.status, 0) << r.output;
   j = nlohmann::json::parse(r.output);
   EXPECT_TRUE(j["shear_rate_dst"].is_null());
+  EXPECT_TRUE(j["max_shear_rate"].is_null());  // CST: any rate flows steadily
+  EXPECT_TRUE(j["max_shear_rate_stress"].is_null());
 }
 
 TEST(RheologyCli, VolumeFractionAndStructure) {
