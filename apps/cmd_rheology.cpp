@@ -101,8 +101,8 @@ void dst_command(CLI::App& rheology) {
     if (!fastest) {
       fmt::print("fastest steady shear: unbounded (the flow curve rises without limit)\n");
     } else if (fastest->attained) {
-      fmt::print("fastest steady shear = {:.6g} 1/s at tau = {:.4g} Pa (where the lower branch turns back); no "
-                 "steady flow is faster\n",
+      fmt::print("fastest steady shear = {:.6g} 1/s at tau = {:.4g} Pa (the flow curve's peak); no steady flow is "
+                 "faster\n",
                  fastest->shear_rate, fastest->shear_stress);
     } else {
       fmt::print("fastest steady shear = gamma_dot_DST, approached as the stress diverges; no steady flow is faster\n");

@@ -251,3 +251,45 @@ TEST(AnnularShear, SteadyBobSpeedLimitIsTheUniformShearProfile) {
   g.outer_radius_m = g.bob_radius_m;
   EXPECT_THROW(steady_bob_speed_limit(gamma, g), InputError);
 }
+
+TEST(AnnularShear, SteadyCouetteLimitMatchesClosedForms) {
+  // Exact 1D Couette: omega_bob(tau_0) = (1/2) integral of gamma_dot(tau)/tau dtau over
+  // [k tau_0, tau_0], k = (r_0/r_o)^2.
+  AnnularGeometry g;
+  g.bob_radius_m = 0.0125;
+  g.outer_radius_m = 0.0485;
+  const double k = std::pow(g.bob_radius_m / g.outer_radius_m, 2);
+  // (a) A flow curve with a hump: gamma_dot = g_m (tau/tau_p) e^(1 - tau/tau_p), so
+  // omega(tau_0) = (e g_m/2)(e^(-k tau_0/tau_p) - e^(-tau_0/tau_p)), largest at
+  // tau_0 = tau_p ln(1/k)/(1 - k).
+  const double gm = 0.4, tp = 5.0;
+  std::vector<double> tau, rate;
+  for (int i = 0; i <= 20000; ++i) {
+    const double t = tp * std::pow(10.0, -6.0 + 9.0 * i / 20000.0);
+    tau.push_back(t);
+    rate.push_back(gm * t / tp * std::exp(1.0 - t / tp));
+  }
+  const double t_star = tp * std::log(1.0 / k) / (1.0 - k);
+  const double u_star = 0.5 * std::exp(1.0) * gm * (std::exp(-k * t_star / tp) - std::exp(-t_star / tp)) * g.bob_radius_m;
+  const auto c = steady_couette_limit(tau, rate, g);
+  EXPECT_NEAR(c.bob_speed_m_per_s, u_star, 1e-6 * u_star);
+  EXPECT_NEAR(c.bob_stress_Pa, t_star, 2e-3 * t_star);
+  EXPECT_FALSE(c.at_end);
+  // Torque balance keeps it below the simple bound (the whole gap at the peak rate g_m).
+  EXPECT_LT(c.bob_speed_m_per_s, steady_bob_speed_limit(gm, g));
+  // (b) A curve rising to an asymptote: gamma_dot = g_inf tau/(tau + tau_c), omega(tau_0) =
+  // (g_inf/2) ln((tau_0 + tau_c)/(k tau_0 + tau_c)), increasing: the last sample decides.
+  const double ginf = 0.3, tc = 2.0;
+  for (std::size_t i = 0; i < tau.size(); ++i) rate[i] = ginf * tau[i] / (tau[i] + tc);
+  const auto d = steady_couette_limit(tau, rate, g);
+  const double t_end = tau.back();
+  EXPECT_TRUE(d.at_end);
+  EXPECT_NEAR(d.bob_speed_m_per_s, 0.5 * ginf * std::log((t_end + tc) / (k * t_end + tc)) * g.bob_radius_m, 1e-8);
+  EXPECT_LT(d.bob_speed_m_per_s, steady_bob_speed_limit(ginf, g));
+  // Bad input.
+  EXPECT_THROW(steady_couette_limit({1.0}, {1.0}, g), InputError);
+  EXPECT_THROW(steady_couette_limit({1.0, 2.0}, {1.0}, g), InputError);
+  EXPECT_THROW(steady_couette_limit({2.0, 1.0, 3.0}, {1.0, 1.0, 1.0}, g), InputError);  // not increasing
+  EXPECT_THROW(steady_couette_limit({1.0, 2.0}, {1.0, -1.0}, g), InputError);
+  EXPECT_THROW(steady_couette_limit({1.0, 2.0}, {1.0, 1.0}, g), InputError);  // spans less than (r_o/r_0)^2
+}

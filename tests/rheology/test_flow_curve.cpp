@@ -191,6 +191,30 @@ TEST(FlowCurve, FastestSteadyShearIsTheSupremumOfTheClosedFormCurve) {
   EXPECT_EQ(humps + asymptotes, 24);
 }
 
+// Shear jamming (Delta = 1, the Singh sets, phi > phi_c): the curve ends at f_jam with gamma_dot
+// -> 0, so the fastest steady shear is an attained peak (brute-force scan of E11 up to f_jam).
+TEST(FlowCurve, FastestSteadyShearOfShearJammingSets) {
+  int checked = 0;
+  for (const auto& fit : paper::fits()) {
+    if (fit.Delta != 1.0) continue;
+    const auto p = rheology::load_preset(fit.name);
+    for (double s : {0.2, 0.6}) {
+      const double phi = fit.phi_c + s * (fit.phi_j - fit.phi_c);
+      SCOPED_TRACE(fit.name + " phi=" + std::to_string(phi));
+      const double f_jam = (fit.phi_j - phi) / (fit.phi_j - fit.phi_c);
+      ASSERT_LT(f_jam, paper::f_m(fit, phi));
+      double scan = 0.0;
+      for (int k = 1; k < 100000; ++k) scan = std::max(scan, paper::gamma_dot_of_f(fit, phi, f_jam * k / 100000.0));
+      const auto lim = rheology::fastest_steady_shear(p.steady, phi);
+      ASSERT_TRUE(lim.has_value());
+      EXPECT_TRUE(lim->attained);
+      EXPECT_LT(rel(lim->shear_rate, scan), 1e-6);
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 4);
+}
+
 // S1 (scenes.md): hermes2016 at the annular cell's phi = 0.505 with its eta_0 = 10 mPa s. The
 // curve is S-shaped: its lower branch turns (brute-force scan of the closed form) above the DST
 // rate, 0.255 1/s by hand from E14.

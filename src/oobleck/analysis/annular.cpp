@@ -342,4 +342,54 @@ double steady_bob_speed_limit(double max_shear_rate_1_s, const AnnularGeometry& 
   return max_shear_rate_1_s * r0 * std::log(ro / r0);
 }
 
+CouetteLimit steady_couette_limit(const std::vector<double>& tau_Pa, const std::vector<double>& gamma_dot_1_s,
+                                  const AnnularGeometry& geometry) {
+  const std::size_t n = tau_Pa.size();
+  if (n < 2 || gamma_dot_1_s.size() != n)
+    throw InputError(fmt::format("steady_couette_limit: {} stresses and {} shear rates: need >= 2 of each, as many",
+                                 n, gamma_dot_1_s.size()));
+  const double r0 = geometry.bob_radius_m, ro = geometry.outer_radius_m;
+  if (!(r0 > 0.0 && ro > r0))
+    throw InputError(fmt::format("steady_couette_limit: radii r_0 = {}, r_o = {} [m]: need 0 < r_0 < r_o", r0, ro));
+  std::vector<double> u(n);  // ln tau
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!(std::isfinite(tau_Pa[k]) && tau_Pa[k] > 0.0 && (k == 0 || tau_Pa[k] > tau_Pa[k - 1])))
+      throw InputError(fmt::format("steady_couette_limit: stress sample {} = {} Pa: stresses must be positive and "
+                                   "strictly increasing",
+                                   k, tau_Pa[k]));
+    if (!(std::isfinite(gamma_dot_1_s[k]) && gamma_dot_1_s[k] >= 0.0))
+      throw InputError(fmt::format("steady_couette_limit: shear rate sample {} = {} 1/s must be finite and >= 0", k,
+                                   gamma_dot_1_s[k]));
+    u[k] = std::log(tau_Pa[k]);
+  }
+  // G(u) = (1/2) integral of gamma_dot du from u_0: exact for gamma_dot linear in u on each interval.
+  std::vector<double> G(n, 0.0);
+  for (std::size_t k = 1; k < n; ++k) G[k] = G[k - 1] + 0.25 * (gamma_dot_1_s[k] + gamma_dot_1_s[k - 1]) * (u[k] - u[k - 1]);
+  auto G_at = [&](double x) {  // u_0 <= x <= u_{n-1}
+    const auto it = std::upper_bound(u.begin(), u.end(), x);
+    const std::size_t j = std::min<std::size_t>(static_cast<std::size_t>(std::max<std::ptrdiff_t>(it - u.begin(), 1)) - 1, n - 2);
+    const double h = u[j + 1] - u[j], s = x - u[j];
+    const double g0 = gamma_dot_1_s[j], g1 = gamma_dot_1_s[j + 1];
+    return G[j] + 0.5 * (g0 * s + 0.5 * (g1 - g0) * s * s / h);
+  };
+  const double span = 2.0 * std::log(ro / r0);  // ln tau_0 - ln tau_wall
+  CouetteLimit best;
+  bool any = false;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (u[k] - span < u[0]) continue;
+    const double omega = G[k] - G_at(u[k] - span);
+    if (!any || omega * r0 > best.bob_speed_m_per_s) {
+      best.bob_speed_m_per_s = omega * r0;
+      best.bob_stress_Pa = tau_Pa[k];
+      best.at_end = k == n - 1;
+      any = true;
+    }
+  }
+  if (!any)
+    throw InputError(fmt::format("steady_couette_limit: the samples span a factor {:.3g} in stress, less than the "
+                                 "gap's (r_o/r_0)^2 = {:.3g}",
+                                 tau_Pa.back() / tau_Pa.front(), (ro / r0) * (ro / r0)));
+  return best;
+}
+
 }  // namespace oobleck::analysis

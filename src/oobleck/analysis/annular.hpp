@@ -134,12 +134,32 @@ struct OuterArrest {
 };
 OuterArrest outer_arrest(const TimeSeries& outer_rotation, double fraction = 0.1);
 
-/// The fastest bob speed [m/s] that admits a steady flow when no material point can shear
+/// An upper bound [m/s] on the bob speed of any steady flow when no material point can shear
 /// steadily faster than `max_shear_rate_1_s` (rheology::fastest_steady_shear at the bed's phi):
-/// in a steady annular flow v_theta = r omega(r), the shear rate is gamma_dot = r |d omega/dr|,
-/// so along any radial line omega_bob = integral of gamma_dot/r dr <= max_shear_rate ln(r_o/r_0),
-/// i.e. u_i <= max_shear_rate r_0 ln(r_o/r_0). A faster bob has no steady state: the stress must
-/// keep growing while it turns. Throws InputError for a non-positive rate or r_o <= r_0.
+/// in a steady annular flow v_theta = r omega(r), the shear rate is gamma_dot >= r |d omega/dr|,
+/// so along any radial line omega_bob = integral of r |d omega/dr| / r dr <= max_shear_rate
+/// ln(r_o/r_0), i.e. u_i <= max_shear_rate r_0 ln(r_o/r_0). A necessary condition only: torque
+/// balance forbids the whole gap shearing at the maximum rate (steady_couette_limit is exact).
+/// Throws InputError for a non-positive rate or r_o <= r_0.
 double steady_bob_speed_limit(double max_shear_rate_1_s, const AnnularGeometry& geometry);
+
+/// The fastest bob speed of a steady 1D annular (Couette) flow of a material with the local
+/// steady flow curve gamma_dot(tau), given as samples with the stress strictly increasing (one
+/// shear rate per stress, as on the model's flow curve swept in f): torque balance gives
+/// tau(r) = tau_0 (r_0/r)^2, so omega_bob(tau_0) = (1/2) integral of gamma_dot(tau)/tau dtau from
+/// tau_0 (r_0/r_o)^2 to tau_0 (gamma_dot linear in ln tau between samples). omega_bob is
+/// continuous in tau_0, so every bob speed up to the maximum over the sampled tau_0 has a steady
+/// flow and none above it. Candidates whose wall stress falls below the first sample are skipped.
+/// `at_end`: the maximum is at the last sample (the curve's top decides; e.g. a DST asymptote
+/// gamma_dot_inf gives omega_bob -> gamma_dot_inf ln(r_o/r_0) as tau_0 -> infinity).
+struct CouetteLimit {
+  double bob_speed_m_per_s = 0.0;  ///< max of u_i = omega_bob r_0 over the sampled bob stresses
+  double bob_stress_Pa = 0.0;      ///< tau_0 at the maximum
+  bool at_end = false;
+};
+/// Throws InputError for fewer than 2 samples, sizes that differ, stresses not positive and
+/// strictly increasing, negative or non-finite rates, r_o <= r_0, or no sample spanning the gap.
+CouetteLimit steady_couette_limit(const std::vector<double>& tau_Pa, const std::vector<double>& gamma_dot_1_s,
+                                  const AnnularGeometry& geometry);
 
 }  // namespace oobleck::analysis

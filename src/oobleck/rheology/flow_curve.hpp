@@ -47,11 +47,11 @@ double eta_r_high(const SteadyParams& p, double phi);
 std::optional<double> shear_rate_dst(const SteadyParams& p, double phi, std::string* reason = nullptr);
 
 /// The fastest steady simple shear at phi: the supremum of gamma_dot over every branch of the
-/// flow curve (E11). On an S-shaped curve it is the lower branch's turning point (attained at a
-/// finite stress); where the upper branch rises monotonically to the DST asymptote (E14) it is
+/// flow curve (E11). On an S-shaped curve it is the lower branch's turning point, and where the
+/// curve ends in shear jamming (gamma_dot -> 0 at f_jam) its peak (both attained at a finite
+/// stress); where the upper branch rises monotonically to the DST asymptote (E14) it is
 /// gamma_dot_DST, approached as the stress diverges (`attained` false, `shear_stress` infinite).
-/// Above it no steady homogeneous flow exists at this phi: a flow driven faster must keep
-/// loading (the stress grows without bound while phi stays fixed).
+/// No steady homogeneous flow at this phi is faster.
 struct SteadyShearLimit {
   double shear_rate = 0.0;    ///< sup gamma_dot [1/s]
   double shear_stress = 0.0;  ///< mixture tau at the supremum [Pa] (infinite when not attained)
@@ -59,8 +59,8 @@ struct SteadyShearLimit {
   bool attained = true;       ///< false: the DST asymptote, reached only as tau -> infinity
 };
 
-/// nullopt where the flow curve is unbounded in gamma_dot (phi < phi_c: CST, any rate flows;
-/// phi > phi* with f_m capped below f_jam). Throws InputError unless 0 < phi < phi_j.
+/// nullopt where the flow curve is unbounded in gamma_dot (phi < phi_c: CST, any rate flows).
+/// Throws InputError unless 0 < phi < phi_j.
 std::optional<SteadyShearLimit> fastest_steady_shear(const SteadyParams& p, double phi);
 
 }  // namespace oobleck::rheology

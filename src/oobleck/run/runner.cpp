@@ -1056,34 +1056,45 @@ nlohmann::json SceneRun<G>::analysis_result() const {
     const auto outer = analysis::outer_rotation_series(shear_frames_, geo);
     a["outer_rotation"] = analysis::to_json(outer);
     a["outer_arrest"] = analysis::to_json(analysis::outer_arrest(outer, 0.1));
-    // Whether the bob's speed admits any steady flow of the bed (docs/analysis.md "Annular
-    // shear"): the fastest steady shear of the flow curve at the bed's phi and the bob speed it allows.
+    // Whether the bob's speed admits a steady flow of the bed at its uniform phi (docs/analysis.md
+    // "Annular shear"): the fastest steady shear of the flow curve, the simple bound it gives and
+    // the exact 1D Couette limit (torque balance over the flow curve).
     {
       nlohmann::json sf;
       const double phi = cfg_.regions.front().phi;
       sf["phi"] = phi;
-      std::optional<rheology::SteadyShearLimit> lim;
-      try {
-        lim = rheology::fastest_steady_shear(cfg_.material.steady, phi);
-      } catch (const InputError& e) {  // phi >= phi_j: jammed, no steady flow at any speed
-        sf["note"] = e.what();
-      }
-      const auto dst = rheology::shear_rate_dst(cfg_.material.steady, phi);
-      sf["shear_rate_dst"] = dst ? nlohmann::json(*dst) : nlohmann::json(nullptr);
       sf["bob_speed"] = geo.bob_speed_m_per_s;
-      if (lim) {
-        sf["max_shear_rate"] = lim->shear_rate;
-        sf["max_shear_rate_stress"] = lim->attained ? nlohmann::json(lim->shear_stress) : nlohmann::json(nullptr);
-        sf["max_shear_rate_is_dst_asymptote"] = !lim->attained;
-        const double limit = analysis::steady_bob_speed_limit(lim->shear_rate, geo);
-        sf["bob_speed_limit"] = limit;
-        sf["steady_flow_possible"] = std::fabs(geo.bob_speed_m_per_s) <= limit;
-      } else {
-        // Unbounded flow curve (CST): every bob speed has a steady state; jammed bed: none.
-        const bool jammed = sf.contains("note");
-        sf["max_shear_rate"] = jammed ? nlohmann::json(0.0) : nlohmann::json(nullptr);
-        sf["bob_speed_limit"] = jammed ? nlohmann::json(0.0) : nlohmann::json(nullptr);
-        sf["steady_flow_possible"] = !jammed;
+      try {
+        const auto& sp = cfg_.material.steady;
+        const auto lim = rheology::fastest_steady_shear(sp, phi);
+        const auto dst = rheology::shear_rate_dst(sp, phi);
+        sf["shear_rate_dst"] = dst ? nlohmann::json(*dst) : nlohmann::json(nullptr);
+        if (lim) {
+          sf["max_shear_rate"] = lim->shear_rate;
+          sf["max_shear_rate_stress"] = lim->attained ? nlohmann::json(lim->shear_stress) : nlohmann::json(nullptr);
+          sf["max_shear_rate_is_dst_asymptote"] = !lim->attained;
+          sf["bob_speed_bound"] = analysis::steady_bob_speed_limit(lim->shear_rate, geo);
+          std::vector<double> tau, rate;
+          for (const auto& pt : rheology::flow_curve(sp, phi, 4000)) {
+            tau.push_back(pt.shear_stress);
+            rate.push_back(pt.shear_rate);
+          }
+          const auto c = analysis::steady_couette_limit(tau, rate, geo);
+          double limit = c.bob_speed_m_per_s;
+          // tau_0 -> infinity on a DST asymptote: omega_bob -> gamma_dot_DST ln(r_o/r_0).
+          if (dst) limit = std::max(limit, analysis::steady_bob_speed_limit(*dst, geo));
+          sf["bob_speed_limit"] = limit;
+          sf["bob_speed_limit_stress"] = limit > c.bob_speed_m_per_s ? nlohmann::json(nullptr) : nlohmann::json(c.bob_stress_Pa);
+          sf["steady_flow_possible"] = std::fabs(geo.bob_speed_m_per_s) <= limit;
+        } else {  // unbounded flow curve (CST): every bob speed has a steady state
+          sf["max_shear_rate"] = nullptr;
+          sf["bob_speed_bound"] = nullptr;
+          sf["bob_speed_limit"] = nullptr;
+          sf["steady_flow_possible"] = true;
+        }
+      } catch (const std::exception& e) {  // phi >= phi_j (jammed, no steady flow), or a failed solve
+        sf["note"] = e.what();
+        sf["steady_flow_possible"] = nullptr;
       }
       a["steady_flow"] = sf;
     }
