@@ -55,13 +55,14 @@ inline double gamma_dot_dst(const Fit& p, double phi) {
          std::pow(2 * p.mu_c * std::pow(eta_B(p, phi) / p.eta_0 * a * phi / (p.phi_j - phi), 2), -1.0 / 3.0);
 }
 
-// Paper eq. (closed-form flow curve, model.md E11 with xi_dot_eps = 0): gamma_dot at structure f,
-// with phi_m(f) = phi_j + (phi_c - phi_j) f, a(f) = a_0 + (a_inf - a_0) f, and
-// tau_bar/(eta_0 gamma_dot) = (mu_c + mu_h) eta_n = 2 mu_c (a phi/(phi_m - phi))^2 + (5/2) phi^2/(phi_m - phi).
+// The steady flow curve at structure f (model.md E11 with xi_dot_eps = 0, from E6 = 0), with
+// phi_m(f) = phi_j + (phi_c - phi_j) f (E1), a(f) = a_0 + (a_inf - a_0) f (E2) and
+// c = tau_bar/(eta_0 gamma_dot) = eta_r - 1 - (5/2) phi, eta_r written out from E3.
 inline double gamma_dot_of_f(const Fit& p, double phi, double f) {
-  const double dphi = p.phi_j + (p.phi_c - p.phi_j) * f - phi;
+  const double phi_m = p.phi_j + (p.phi_c - p.phi_j) * f;
   const double a = p.a_0 + (p.a_inf - p.a_0) * f;
-  const double c = 2 * p.mu_c * std::pow(a * phi / dphi, 2) + 2.5 * phi * phi / dphi;
+  const double eta_r = 1 + 2.5 * phi * phi_m / (phi_m - phi) + 2 * p.mu_c * std::pow(a * phi / (phi_m - phi), 2);
+  const double c = eta_r - 1 - 2.5 * phi;
   return p.tau_star / (c * p.eta_0) * std::pow((1 + c * p.eta_0 / eta_B(p, phi)) * f / (f_m(p, phi) - f), 2.0 / 3.0);
 }
 
