@@ -333,13 +333,20 @@ OuterArrest outer_arrest(const TimeSeries& outer_rotation, double fraction) {
   return a;
 }
 
+namespace {
+/// ln(r_o/r_0) of the gap; throws InputError (naming `who`) unless 0 < r_0 < r_o.
+double log_radius_ratio(const AnnularGeometry& geometry, const char* who) {
+  const double r0 = geometry.bob_radius_m, ro = geometry.outer_radius_m;
+  if (!(r0 > 0.0 && ro > r0))
+    throw InputError(fmt::format("{}: radii r_0 = {}, r_o = {} [m]: need 0 < r_0 < r_o", who, r0, ro));
+  return std::log(ro / r0);
+}
+}  // namespace
+
 double steady_bob_speed_limit(double max_shear_rate_1_s, const AnnularGeometry& geometry) {
   if (!(std::isfinite(max_shear_rate_1_s) && max_shear_rate_1_s > 0.0))
     throw InputError(fmt::format("steady_bob_speed_limit: shear rate = {} must be positive [1/s]", max_shear_rate_1_s));
-  const double r0 = geometry.bob_radius_m, ro = geometry.outer_radius_m;
-  if (!(r0 > 0.0 && ro > r0))
-    throw InputError(fmt::format("steady_bob_speed_limit: radii r_0 = {}, r_o = {} [m]: need 0 < r_0 < r_o", r0, ro));
-  return max_shear_rate_1_s * r0 * std::log(ro / r0);
+  return max_shear_rate_1_s * geometry.bob_radius_m * log_radius_ratio(geometry, "steady_bob_speed_limit");
 }
 
 CouetteLimit steady_couette_limit(const std::vector<double>& tau_Pa, const std::vector<double>& gamma_dot_1_s,
@@ -349,8 +356,7 @@ CouetteLimit steady_couette_limit(const std::vector<double>& tau_Pa, const std::
     throw InputError(fmt::format("steady_couette_limit: {} stresses and {} shear rates: need >= 2 of each, as many",
                                  n, gamma_dot_1_s.size()));
   const double r0 = geometry.bob_radius_m, ro = geometry.outer_radius_m;
-  if (!(r0 > 0.0 && ro > r0))
-    throw InputError(fmt::format("steady_couette_limit: radii r_0 = {}, r_o = {} [m]: need 0 < r_0 < r_o", r0, ro));
+  const double span = 2.0 * log_radius_ratio(geometry, "steady_couette_limit");  // ln tau_0 - ln tau_wall
   std::vector<double> u(n);  // ln tau
   for (std::size_t k = 0; k < n; ++k) {
     if (!(std::isfinite(tau_Pa[k]) && tau_Pa[k] > 0.0 && (k == 0 || tau_Pa[k] > tau_Pa[k - 1])))
@@ -372,7 +378,6 @@ CouetteLimit steady_couette_limit(const std::vector<double>& tau_Pa, const std::
     const double g0 = gamma_dot_1_s[j], g1 = gamma_dot_1_s[j + 1];
     return G[j] + 0.5 * (g0 * s + 0.5 * (g1 - g0) * s * s / h);
   };
-  const double span = 2.0 * std::log(ro / r0);  // ln tau_0 - ln tau_wall
   CouetteLimit best;
   bool any = false;
   for (std::size_t k = 0; k < n; ++k) {
