@@ -632,4 +632,14 @@ std::int64_t grid_to_particles(Body<G>& body, const ShapeCache<G::dim>& cache, c
   return run.template operator()<true, false>();
 }
 
+// The axisymmetric G2P is compiled in its own translation unit, transfer_axisymmetric.cpp, with
+// 128-bit auto-vectorisation (see there and docs/mpm.md "Performance"); the other units use it.
+#define OOBLECK_AXISYMMETRIC_G2P(KIND, K)                                                                  \
+  KIND template std::int64_t grid_to_particles<Axisymmetric, K>(                                           \
+      Body<Axisymmetric>&, const ShapeCache<2>&, const GridField<Axisymmetric>&, const Grid<2>&, Transfer, \
+      double, double, const double*, const Vec<3>*);
+OOBLECK_AXISYMMETRIC_G2P(extern, 4)
+OOBLECK_AXISYMMETRIC_G2P(extern, 9)
+OOBLECK_AXISYMMETRIC_G2P(extern, 16)
+
 }  // namespace oobleck::mpm
