@@ -17,6 +17,7 @@ ROUNDS=${3:-5}; THREADS=${4:-"1 2"}; SCENES=${5:-"intruder wheel"}
 for x in "$A" "$B"; do
   [ -x "$x" ] || { echo "compare_builds: '$x' is not an executable oobleck" >&2; exit 2; }
 done
+A=$(realpath -- "$A"); B=$(realpath -- "$B")  # before the cd below
 cd "$(dirname "$0")/.."
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
@@ -27,8 +28,9 @@ for r in $(seq 1 "$ROUNDS"); do
         x=$A; [ $label = B ] && x=$B
         d="$out/run"
         rm -rf "$d"
-        OMP_NUM_THREADS=$t "$x" run "bench/scenes/${s}_authors_setup.toml" --threads "$t" --out "$d" --quiet >/dev/null
-        cp "$d/summary.json" "$out/$label.$s.$t.$r.json"
+        OMP_NUM_THREADS=$t "$x" run "bench/scenes/${s}_authors_setup.toml" --threads "$t" --out "$d" --quiet >/dev/null ||
+          { echo "compare_builds: build $label ($x) failed on $s, $t threads, round $r" >&2; exit 1; }
+        cp "$d/summary.json" "$out/$label.$t.$r.$s.json"
       done
     done
   done
@@ -39,7 +41,7 @@ import glob, json, os, statistics, sys
 out, exe_a, exe_b = sys.argv[1:4]
 runs = {}
 for f in sorted(glob.glob(os.path.join(out, "*.json"))):
-    label, scene, threads, _ = os.path.basename(f).split(".")[:4]
+    label, threads, _, scene = os.path.basename(f)[: -len(".json")].split(".", 3)
     runs.setdefault((scene, int(threads), label), []).append(json.load(open(f)))
 print(f"A = {exe_a}\nB = {exe_b}")
 print(f"{'scene':<9} {'thr':>3} {'build':<5} {'median/s':>10} {'best/s':>10} {'B/A':>6}  phase medians [s]")

@@ -476,6 +476,8 @@ class Solver {
 
   template <int K>
   void grid_to_particles_all() {
+    static_assert(!std::is_same_v<G, Axisymmetric> || K == 4 || K == 9 || K == 16,
+                  "a new kernel support: add its axisymmetric G2P to transfer_axisymmetric.cpp");
     non_finite_kinematics_.resize(bodies_.size());
     for (std::size_t b = 0; b < bodies_.size(); ++b) {
       if (rigid_[b].rigid()) {
