@@ -50,12 +50,18 @@ inline double update_fluid_volume_ratio(double J, double div_q_per_s, double por
   return J * std::exp(dt_s * div_q_per_s / porosity);
 }
 
+/// Fluid Cauchy stress σ_f = τ_f − p_f 1 [Pa] (E25) for a given pressure p_f [Pa].
+inline Eigen::Matrix3d fluid_cauchy_stress_at_pressure(const Eigen::Matrix3d& L, double phi, double p_f_Pa,
+                                                       double eta_0_Pa_s) {
+  Eigen::Matrix3d s = fluid_viscous_stress(L, phi, eta_0_Pa_s);
+  s.diagonal().array() -= p_f_Pa;
+  return s;
+}
+
 /// Fluid Cauchy stress σ_f = τ_f − p_f 1 [Pa] (E25 + E26); `J` = ρ_f0/ρ_f.
 inline Eigen::Matrix3d fluid_cauchy_stress(const Eigen::Matrix3d& L, double phi, double J,
                                            const FluidParams& p) {
-  Eigen::Matrix3d s = fluid_viscous_stress(L, phi, p.eta_0_Pa_s);
-  s.diagonal().array() -= fluid_pressure(J, p.kappa_Pa);
-  return s;
+  return fluid_cauchy_stress_at_pressure(L, phi, fluid_pressure(J, p.kappa_Pa), p.eta_0_Pa_s);
 }
 
 /// Fluid pressure-wave speed √(κ/ρ_f) [m/s] used by the stable time step (model.md §6).

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "oobleck/core/error.hpp"
+#include "oobleck/numerics/vector_math.hpp"
 #include "oobleck/rheology/f_max.hpp"
 
 namespace oobleck::material {
@@ -63,21 +64,6 @@ double GranularLaw::mu_q(double I_m) const {
 }
 
 namespace {
-
-/// x^alpha for alpha >= 0, with small integer exponents by multiplication (E8 is evaluated per call);
-/// int_alpha: alpha as an int when it is a whole number <= 8, else INT_MIN (GranularLaw::kNonInteger).
-inline double pow_term(double x, double alpha, int int_alpha, double& log_x, bool& have_log) {
-  if (int_alpha != std::numeric_limits<int>::min()) {
-    double y = 1.0;
-    for (int k = 0; k < int_alpha; ++k) y *= x;
-    return y;
-  }
-  if (!have_log) {
-    log_x = std::log(x);
-    have_log = true;
-  }
-  return std::exp(alpha * log_x);
-}
 
 /// A 3x3 tensor as nine numbers, column-major (Eigen's order), for the functions below that also
 /// run in lanes across points: GCC 12 vectorises an `omp simd` loop that passes these by reference
@@ -694,16 +680,40 @@ inline bool GranularLaw::begin(const GranularState& state, const Eigen::Matrix3d
 }
 
 double GranularLaw::inv_eta_B(double phi) const {
-  double r = 0.0;
-  if (const double gap = phi_j_ - phi; gap > 0.0) {
-    double lg = 0.0;
-    bool have = false;
-    for (std::size_t i = 0; i < steady_.eta_B_terms.size(); ++i) {
-      const rheology::EtaBTerm& term = steady_.eta_B_terms[i];
-      r += term.phi_i * pow_term(gap, term.alpha, eta_B_int_alpha_[i], lg, have);
+  double x[numerics::kMathBlock], r[numerics::kMathBlock];
+  for (double& v : x) v = phi;
+  inv_eta_B_block(x, r);
+  return r[0];
+}
+
+void GranularLaw::inv_eta_B_block(const double* phi, double* r) const {
+  // E8: 1/eta_B = sum_i phi_i (phi_j - phi)^alpha_i, summed in the order of the terms; whole
+  // alpha <= 8 by multiplication, the others as exp(alpha log(phi_j - phi)).
+  constexpr int N = numerics::kMathBlock;
+  double gap[N], lg[N], arg[N], e[N];
+  for (int j = 0; j < N; ++j) {
+    const double g = phi_j_ - phi[j];
+    gap[j] = g > 0.0 ? g : 1.0;  // (a finite stand-in where the result is 0)
+    r[j] = 0.0;
+  }
+  if (std::find(eta_B_int_alpha_.begin(), eta_B_int_alpha_.end(), kNonInteger) != eta_B_int_alpha_.end())
+    numerics::log_block(gap, lg);
+  for (std::size_t t = 0; t < steady_.eta_B_terms.size(); ++t) {
+    const rheology::EtaBTerm& term = steady_.eta_B_terms[t];
+    if (const int k = eta_B_int_alpha_[t]; k != kNonInteger) {
+      for (int j = 0; j < N; ++j) {
+        double y = 1.0;
+        for (int q = 0; q < k; ++q) y *= gap[j];
+        r[j] += term.phi_i * y;
+      }
+    } else {
+      for (int j = 0; j < N; ++j) arg[j] = term.alpha * lg[j];
+      numerics::exp_block(arg, e);
+      for (int j = 0; j < N; ++j) r[j] += term.phi_i * e[j];
     }
   }
-  return r;
+  for (int j = 0; j < N; ++j)
+    if (!(phi_j_ - phi[j] > 0.0)) r[j] = 0.0;
 }
 
 template <bool kDiagnostics>
@@ -945,9 +955,15 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
       t_fm[i] = rheology::f_m(steady_, ph);
     }
     for (int i = 0; i < m; ++i) valid[i] = ok_lane[i] != 0.0;
-    // E8 on its own: pow() for a non-integer alpha (log and exp of libm) in a loop of independent
-    // calls, which the processor overlaps (inside begin() they serialised with the trial)
-    for (int i = 0; i < m; ++i) t_inv_eta_B[i] = valid[i] ? inv_eta_B(phi[b0 + i]) : 0.0;
+    // E8 on its own, in blocks with the powers in vector lanes (inside begin() they serialised
+    // with the trial); lanes of invalid points (and past m) get a stand-in phi and then 0
+    static_assert(kBlock % numerics::kMathBlock == 0);
+    for (int i0 = 0; i0 < m; i0 += numerics::kMathBlock) {
+      double x[numerics::kMathBlock], r[numerics::kMathBlock];
+      for (int j = 0; j < numerics::kMathBlock; ++j) x[j] = i0 + j < m && valid[i0 + j] ? phi[b0 + i0 + j] : 0.5;
+      inv_eta_B_block(x, r);
+      for (int j = 0; j < numerics::kMathBlock && i0 + j < m; ++j) t_inv_eta_B[i0 + j] = valid[i0 + j] ? r[j] : 0.0;
+    }
     const double phi_j = phi_j_, phi_c = phi_c_, a_0 = a_0_, a_inf = a_inf_, eta_0 = eta_0_;
 #pragma omp simd
     for (int i = 0; i < m; ++i) {

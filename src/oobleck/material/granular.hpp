@@ -184,8 +184,12 @@ class GranularLaw {
   /// Input checks, E16 trial, f_m and 1/eta_B; false (out says why) for invalid input.
   bool begin(const GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W, double dt, double phi,
              double eta_0, Trial& t, GranularUpdate& out) const;
-  /// 1/eta_B(phi) of E8 (0 for phi >= phi_j) [1/(Pa s)].
+  /// 1/eta_B(phi) of E8 (0 for phi >= phi_j) [1/(Pa s)]: inv_eta_B_block with every lane at phi,
+  /// so that it equals the value advance_batch computes for the point, bit for bit.
   double inv_eta_B(double phi) const;
+  /// 1/eta_B of E8 for numerics::kMathBlock values of phi (0 where phi >= phi_j or phi is NaN), the
+  /// non-integer powers as exp(alpha log(phi_j - phi)) in vector lanes (numerics/vector_math.hpp).
+  void inv_eta_B_block(const double* phi, double* inv_eta_B) const;
   /// Structure update (E24, staggered or implicit) after the return map r at f_n, diagnostics and
   /// the final stress; writes state when the result is finite.
   template <bool kDiagnostics>

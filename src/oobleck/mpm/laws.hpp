@@ -6,6 +6,7 @@
 #include "oobleck/material/elastic.hpp"
 #include "oobleck/material/fluid.hpp"
 #include "oobleck/mpm/body.hpp"
+#include "oobleck/numerics/vector_math.hpp"
 
 namespace oobleck::mpm {
 
@@ -49,15 +50,34 @@ class FluidLaw final : public StressLaw<G> {
  public:
   FluidLaw(const material::FluidParams& p, double min_porosity) : p_(p), n_min_(min_porosity) {}
   void resize(std::int64_t n) override { J.resize(static_cast<std::size_t>(n), 1.0); }
+  /// E27 J ← J exp(Δt div q / n) (material::update_fluid_volume_ratio), E26 p_f = −κ ln J
+  /// (material::fluid_pressure) and E25, for blocks of points with the exp and log in vector lanes
+  /// (numerics/vector_math.hpp).
   void update_stress(Body<G>& body, double dt_s) override {
     const std::int64_t np = body.size();
+    constexpr int kBlock = numerics::kMathBlock;
+    const std::int64_t blocks = (np + kBlock - 1) / kBlock;
     std::int64_t bad = kAllFinite;
 #pragma omp parallel for schedule(static) reduction(min : bad)
-    for (std::int64_t q = 0; q < np; ++q) {
-      const double n = std::max(1.0 - body.phi[q], n_min_);
-      J[q] = material::update_fluid_volume_ratio(J[q], body.div_q_1_s[q], n, dt_s);  // E27
-      body.stress_Pa[q] = material::fluid_cauchy_stress(body.L_1_s[q], body.phi[q], J[q], p_);  // E25, E26
-      if (!std::isfinite(body.stress_Pa[q].sum())) bad = std::min(bad, q);
+    for (std::int64_t blk = 0; blk < blocks; ++blk) {
+      const std::int64_t q0 = blk * kBlock;
+      const int nb = static_cast<int>(std::min<std::int64_t>(kBlock, np - q0));
+      double arg[kBlock], factor[kBlock], Jn[kBlock], lnJ[kBlock];
+      for (int j = 0; j < kBlock; ++j) {
+        const std::int64_t q = q0 + std::min(j, nb - 1);  // (lanes past the end repeat the last point)
+        const double n = std::max(1.0 - body.phi[q], n_min_);
+        arg[j] = dt_s * body.div_q_1_s[q] / n;
+      }
+      numerics::exp_block(arg, factor);
+      for (int j = 0; j < kBlock; ++j) Jn[j] = J[q0 + std::min(j, nb - 1)] * factor[j];  // E27
+      numerics::log_block(Jn, lnJ);
+      for (int j = 0; j < nb; ++j) {
+        const std::int64_t q = q0 + j;
+        J[q] = Jn[j];
+        const double p_f = -p_.kappa_Pa * lnJ[j];  // E26
+        body.stress_Pa[q] = material::fluid_cauchy_stress_at_pressure(body.L_1_s[q], body.phi[q], p_f, p_.eta_0_Pa_s);
+        if (!std::isfinite(body.stress_Pa[q].sum())) bad = std::min(bad, q);
+      }
     }
     first_bad_ = bad;
   }

@@ -16,6 +16,7 @@
 #include "oobleck/mpm/body.hpp"
 #include "oobleck/mpm/grid.hpp"
 #include "oobleck/mpm/shape.hpp"
+#include "oobleck/numerics/vector_math.hpp"
 
 namespace oobleck::mpm {
 
@@ -362,242 +363,259 @@ std::int64_t grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& c
   Mat3* const Ls = body.L_1_s.data();
   double* const Vs = body.volume_m3.data();
   std::int64_t bad = kAllFinite;
+  // Points in blocks of numerics::kMathBlock: the per-point work, then the block's volume update
+  // V ← V exp(Δt tr L) (step 7) with the exponentials in vector lanes (numerics/vector_math.hpp)
+  // and the NaN guard.
+  constexpr int kBlock = numerics::kMathBlock;
+  const std::int64_t blocks = (np + kBlock - 1) / kBlock;
 #pragma omp parallel for schedule(static) reduction(min : bad)
-  for (std::int64_t p = 0; p < np; ++p) {
-    // Components 0–1 as one 2-vector (one SIMD register), component 2 (if any) as a scalar.
-    V2 vp2 = V2::Zero(), dv2 = V2::Zero(), q2 = V2::Zero(), gv2[D], B2[D];
-    double vp3 = 0.0, dv3 = 0.0, q3 = 0.0, gv3[D], B3[D];
-    for (int a = 0; a < D; ++a) {
-      gv2[a].setZero();
-      B2[a].setZero();
-      gv3[a] = 0.0;
-      B3[a] = 0.0;
-    }
-    double n_p = 0.0, div_q = 0.0;
-    if constexpr (D == 2) {
-      // The tensor product factorised (as in P2G): per row j0 the sums over j1 of N_1 v_i,
-      // N'_1 v_i and N_1 o_1 v_i, then ∑N v = ∑ N_0 (∑N_1 v), ∇: (∑ N'_0 (∑N_1 v), ∑ N_0 (∑N'_1 v)),
-      // B = ∑N v (x_i − x_p)ᵀ = (∑ N_0 o_0 (∑N_1 v), ∑ N_0 (∑N_1 o_1 v)).
-      const Stencil<D, S>& st = cache.template stencil<S>(p);
-      const SecondAxisFactors<S> a1(st);
-      OOBLECK_UNROLL
-      for (int j0 = 0; j0 < S; ++j0) {
-        const double w0 = st.w[j0][0], dw0 = st.dw[j0][0], o0 = st.off[j0][0];
-        V2 t2 = V2::Zero(), tg2 = V2::Zero(), to2 = V2::Zero(), td2 = V2::Zero(), tq2 = V2::Zero();
-        double t3 = 0.0, tg3 = 0.0, to3 = 0.0, td3 = 0.0, tq3 = 0.0, tn = 0.0, tqy = 0.0;
-        const int row = st.index[j0][0];
-        OOBLECK_UNROLL
-        for (int j1 = 0; j1 < S; ++j1) {
-          const int i = row + st.index[j1][1];
-          const double w1 = st.w[j1][1], dw1 = st.dw[j1][1];
-          const double* vi = vel + static_cast<std::int64_t>(i) * NC;
-          const V2 vi2 = Eigen::Map<const V2>(vi);
-          t2 += a1.w[j1].cwiseProduct(vi2);
-          tg2 += a1.dw[j1].cwiseProduct(vi2);
-          if constexpr (NC == 3) {
-            t3 += w1 * vi[2];
-            tg3 += dw1 * vi[2];
-          }
-          if constexpr (Apic && !ByGrad) {
-            to2 += a1.wo[j1].cwiseProduct(vi2);
-            if constexpr (NC == 3) to3 += (w1 * st.off[j1][1]) * vi[2];
-          }
-          if constexpr (!Apic) {
-            const double* vo = vel_old + static_cast<std::int64_t>(i) * NC;
-            td2 += a1.w[j1].cwiseProduct(vi2 - Eigen::Map<const V2>(vo));
-            if constexpr (NC == 3) td3 += w1 * (vi[2] - vo[2]);
-          }
-          if constexpr (Mixture) {
-            const double* qi = flux + static_cast<std::int64_t>(i) * NC;
-            tn += w1 * porosity[i];
-            tq2 += a1.w[j1].cwiseProduct(Eigen::Map<const V2>(qi));
-            tqy += dw1 * qi[1];
-            if constexpr (G::has_hoop_terms) tq3 += w1 * qi[2];
-          }
-        }
-        vp2 += w0 * t2;
-        gv2[0] += dw0 * t2;
-        gv2[1] += w0 * tg2;
-        if constexpr (NC == 3) {
-          vp3 += w0 * t3;
-          gv3[0] += dw0 * t3;
-          gv3[1] += w0 * tg3;
-        }
-        if constexpr (Apic && !ByGrad) {
-          B2[0] += (w0 * o0) * t2;
-          B2[1] += w0 * to2;
-          if constexpr (NC == 3) {
-            B3[0] += (w0 * o0) * t3;
-            B3[1] += w0 * to3;
-          }
-        }
-        if constexpr (!Apic) {
-          dv2 += w0 * td2;
-          if constexpr (NC == 3) dv3 += w0 * td3;
-        }
-        if constexpr (Mixture) {
-          n_p += w0 * tn;
-          div_q += dw0 * tq2[0] + w0 * tqy;
-          if constexpr (G::has_hoop_terms) {
-            q2 += w0 * tq2;
-            q3 += w0 * tq3;
-          }
-        }
-        (void)o0;
+  for (std::int64_t blk = 0; blk < blocks; ++blk) {
+    const std::int64_t p0 = blk * kBlock;
+    const int nb = static_cast<int>(std::min<std::int64_t>(kBlock, np - p0));
+    // per point: Δt tr L, the new x and v summed (for the guard), exp(Δt tr L)
+    double vol_arg[kBlock], kin_sum[kBlock], vol_factor[kBlock];
+    for (int j = nb; j < kBlock; ++j) vol_arg[j] = 0.0;
+    for (int j = 0; j < nb; ++j) {
+      const std::int64_t p = p0 + j;
+      // Components 0–1 as one 2-vector (one SIMD register), component 2 (if any) as a scalar.
+      V2 vp2 = V2::Zero(), dv2 = V2::Zero(), q2 = V2::Zero(), gv2[D], B2[D];
+      double vp3 = 0.0, dv3 = 0.0, q3 = 0.0, gv3[D], B3[D];
+      for (int a = 0; a < D; ++a) {
+        gv2[a].setZero();
+        B2[a].setZero();
+        gv3[a] = 0.0;
+        B3[a] = 0.0;
       }
-    } else {
-      for_each_node<D, S>(cache.template stencil<S>(p), [&](int i, double w, const double* g, const double* off) {
-        const double* vi = vel + static_cast<std::int64_t>(i) * NC;
-        const V2 vi2 = Eigen::Map<const V2>(vi);
-        const double vi3 = NC == 3 ? vi[NC - 1] : 0.0;
-        if constexpr (Mixture) {
-          const double* qi = flux + static_cast<std::int64_t>(i) * NC;
-          n_p += w * porosity[i];
-          double d = qi[0] * g[0];
-          for (int a = 1; a < D; ++a) d += qi[a] * g[a];
-          div_q += d;
-          if constexpr (G::has_hoop_terms) {
-            q2 += w * Eigen::Map<const V2>(qi);
-            q3 += w * qi[2];
-          }
-        }
-        vp2 += w * vi2;
-        if constexpr (NC == 3) vp3 += w * vi3;
-        for (int a = 0; a < D; ++a) {
-          gv2[a] += vi2 * g[a];
-          if constexpr (NC == 3) gv3[a] += vi3 * g[a];
-        }
-        if constexpr (Apic) {
-          if constexpr (!ByGrad) {
-            const V2 wv2 = w * vi2;
-            const double wv3 = w * vi3;
-            for (int a = 0; a < D; ++a) {
-              B2[a] += wv2 * off[a];
-              if constexpr (NC == 3) B3[a] += wv3 * off[a];
+      double n_p = 0.0, div_q = 0.0;
+      if constexpr (D == 2) {
+        // The tensor product factorised (as in P2G): per row j0 the sums over j1 of N_1 v_i,
+        // N'_1 v_i and N_1 o_1 v_i, then ∑N v = ∑ N_0 (∑N_1 v), ∇: (∑ N'_0 (∑N_1 v), ∑ N_0 (∑N'_1 v)),
+        // B = ∑N v (x_i − x_p)ᵀ = (∑ N_0 o_0 (∑N_1 v), ∑ N_0 (∑N_1 o_1 v)).
+        const Stencil<D, S>& st = cache.template stencil<S>(p);
+        const SecondAxisFactors<S> a1(st);
+        OOBLECK_UNROLL
+        for (int j0 = 0; j0 < S; ++j0) {
+          const double w0 = st.w[j0][0], dw0 = st.dw[j0][0], o0 = st.off[j0][0];
+          V2 t2 = V2::Zero(), tg2 = V2::Zero(), to2 = V2::Zero(), td2 = V2::Zero(), tq2 = V2::Zero();
+          double t3 = 0.0, tg3 = 0.0, to3 = 0.0, td3 = 0.0, tq3 = 0.0, tn = 0.0, tqy = 0.0;
+          const int row = st.index[j0][0];
+          OOBLECK_UNROLL
+          for (int j1 = 0; j1 < S; ++j1) {
+            const int i = row + st.index[j1][1];
+            const double w1 = st.w[j1][1], dw1 = st.dw[j1][1];
+            const double* vi = vel + static_cast<std::int64_t>(i) * NC;
+            const V2 vi2 = Eigen::Map<const V2>(vi);
+            t2 += a1.w[j1].cwiseProduct(vi2);
+            tg2 += a1.dw[j1].cwiseProduct(vi2);
+            if constexpr (NC == 3) {
+              t3 += w1 * vi[2];
+              tg3 += dw1 * vi[2];
+            }
+            if constexpr (Apic && !ByGrad) {
+              to2 += a1.wo[j1].cwiseProduct(vi2);
+              if constexpr (NC == 3) to3 += (w1 * st.off[j1][1]) * vi[2];
+            }
+            if constexpr (!Apic) {
+              const double* vo = vel_old + static_cast<std::int64_t>(i) * NC;
+              td2 += a1.w[j1].cwiseProduct(vi2 - Eigen::Map<const V2>(vo));
+              if constexpr (NC == 3) td3 += w1 * (vi[2] - vo[2]);
+            }
+            if constexpr (Mixture) {
+              const double* qi = flux + static_cast<std::int64_t>(i) * NC;
+              tn += w1 * porosity[i];
+              tq2 += a1.w[j1].cwiseProduct(Eigen::Map<const V2>(qi));
+              tqy += dw1 * qi[1];
+              if constexpr (G::has_hoop_terms) tq3 += w1 * qi[2];
             }
           }
-        } else {
-          const double* vo = vel_old + static_cast<std::int64_t>(i) * NC;
-          dv2 += w * (vi2 - Eigen::Map<const V2>(vo));
-          if constexpr (NC == 3) dv3 += w * (vi3 - vo[2]);
+          vp2 += w0 * t2;
+          gv2[0] += dw0 * t2;
+          gv2[1] += w0 * tg2;
+          if constexpr (NC == 3) {
+            vp3 += w0 * t3;
+            gv3[0] += dw0 * t3;
+            gv3[1] += w0 * tg3;
+          }
+          if constexpr (Apic && !ByGrad) {
+            B2[0] += (w0 * o0) * t2;
+            B2[1] += w0 * to2;
+            if constexpr (NC == 3) {
+              B3[0] += (w0 * o0) * t3;
+              B3[1] += w0 * to3;
+            }
+          }
+          if constexpr (!Apic) {
+            dv2 += w0 * td2;
+            if constexpr (NC == 3) dv3 += w0 * td3;
+          }
+          if constexpr (Mixture) {
+            n_p += w0 * tn;
+            div_q += dw0 * tq2[0] + w0 * tqy;
+            if constexpr (G::has_hoop_terms) {
+              q2 += w0 * tq2;
+              q3 += w0 * tq3;
+            }
+          }
+          (void)o0;
         }
-        (void)off;
-      });
-    }
-    if constexpr (D == 2) {
-      // The point's update written straight from the accumulators to its arrays, component by
-      // component (a temporary vector or matrix filled by parts and read whole stalls on store
-      // forwarding); the same values as the general path below.
-      double* const xp = xs[p].data();
-      const double x_old0 = xp[0], x_old1 = xp[1];
-      const double xn0 = grid.wrapped(0, x_old0 + dt_s * vp2[0]), xn1 = grid.wrapped(1, x_old1 + dt_s * vp2[1]);
-      xp[0] = xn0;
-      xp[1] = xn1;
-      double* const vq = vs[p].data();
-      double v_new[NC];
-      if constexpr (Apic) {
-        Eigen::Map<V2>{v_new} = vp2;
-        if constexpr (NC == 3) v_new[2] = vp3;
       } else {
-        const V2 vb = alpha * (Eigen::Map<const V2>(vq) + dv2) + (1.0 - alpha) * vp2;
-        Eigen::Map<V2>{v_new} = vb;
-        if constexpr (NC == 3) v_new[2] = alpha * (vq[2] + dv3) + (1.0 - alpha) * vp3;
-      }
-      double v_pic[NC];
-      Eigen::Map<V2>{v_pic} = vp2;
-      if constexpr (NC == 3) v_pic[2] = vp3;
-      for (int c = 0; c < NC; ++c) vq[c] = v_new[c];
-      double g[D][NC];
-      for (int a = 0; a < D; ++a) {
-        Eigen::Map<V2>{g[a]} = gv2[a];
-        if constexpr (NC == 3) g[a][2] = gv3[a];
-      }
-      if constexpr (Apic) {
-        double* const Cq = Cs[p].data();  // column-major NC × D
-        for (int a = 0; a < D; ++a) {
-          if constexpr (ByGrad) {
-            for (int c = 0; c < NC; ++c) Cq[a * NC + c] = g[a][c];
+        for_each_node<D, S>(cache.template stencil<S>(p), [&](int i, double w, const double* g, const double* off) {
+          const double* vi = vel + static_cast<std::int64_t>(i) * NC;
+          const V2 vi2 = Eigen::Map<const V2>(vi);
+          const double vi3 = NC == 3 ? vi[NC - 1] : 0.0;
+          if constexpr (Mixture) {
+            const double* qi = flux + static_cast<std::int64_t>(i) * NC;
+            n_p += w * porosity[i];
+            double d = qi[0] * g[0];
+            for (int a = 1; a < D; ++a) d += qi[a] * g[a];
+            div_q += d;
+            if constexpr (G::has_hoop_terms) {
+              q2 += w * Eigen::Map<const V2>(qi);
+              q3 += w * qi[2];
+            }
+          }
+          vp2 += w * vi2;
+          if constexpr (NC == 3) vp3 += w * vi3;
+          for (int a = 0; a < D; ++a) {
+            gv2[a] += vi2 * g[a];
+            if constexpr (NC == 3) gv3[a] += vi3 * g[a];
+          }
+          if constexpr (Apic) {
+            if constexpr (!ByGrad) {
+              const V2 wv2 = w * vi2;
+              const double wv3 = w * vi3;
+              for (int a = 0; a < D; ++a) {
+                B2[a] += wv2 * off[a];
+                if constexpr (NC == 3) B3[a] += wv3 * off[a];
+              }
+            }
           } else {
-            const double sD = inv_D[p * D + a];
-            Eigen::Map<V2>(Cq + a * NC) = B2[a] * sD;
-            if constexpr (NC == 3) Cq[a * NC + 2] = B3[a] * sD;
+            const double* vo = vel_old + static_cast<std::int64_t>(i) * NC;
+            dv2 += w * (vi2 - Eigen::Map<const V2>(vo));
+            if constexpr (NC == 3) dv3 += w * (vi3 - vo[2]);
+          }
+          (void)off;
+        });
+      }
+      if constexpr (D == 2) {
+        // The point's update written straight from the accumulators to its arrays, component by
+        // component (a temporary vector or matrix filled by parts and read whole stalls on store
+        // forwarding); the same values as the general path below.
+        double* const xp = xs[p].data();
+        const double x_old0 = xp[0], x_old1 = xp[1];
+        const double xn0 = grid.wrapped(0, x_old0 + dt_s * vp2[0]), xn1 = grid.wrapped(1, x_old1 + dt_s * vp2[1]);
+        xp[0] = xn0;
+        xp[1] = xn1;
+        double* const vq = vs[p].data();
+        double v_new[NC];
+        if constexpr (Apic) {
+          Eigen::Map<V2>{v_new} = vp2;
+          if constexpr (NC == 3) v_new[2] = vp3;
+        } else {
+          const V2 vb = alpha * (Eigen::Map<const V2>(vq) + dv2) + (1.0 - alpha) * vp2;
+          Eigen::Map<V2>{v_new} = vb;
+          if constexpr (NC == 3) v_new[2] = alpha * (vq[2] + dv3) + (1.0 - alpha) * vp3;
+        }
+        double v_pic[NC];
+        Eigen::Map<V2>{v_pic} = vp2;
+        if constexpr (NC == 3) v_pic[2] = vp3;
+        for (int c = 0; c < NC; ++c) vq[c] = v_new[c];
+        double g[D][NC];
+        for (int a = 0; a < D; ++a) {
+          Eigen::Map<V2>{g[a]} = gv2[a];
+          if constexpr (NC == 3) g[a][2] = gv3[a];
+        }
+        if constexpr (Apic) {
+          double* const Cq = Cs[p].data();  // column-major NC × D
+          for (int a = 0; a < D; ++a) {
+            if constexpr (ByGrad) {
+              for (int c = 0; c < NC; ++c) Cq[a * NC + c] = g[a][c];
+            } else {
+              const double sD = inv_D[p * D + a];
+              Eigen::Map<V2>(Cq + a * NC) = B2[a] * sD;
+              if constexpr (NC == 3) Cq[a * NC + 2] = B3[a] * sD;
+            }
           }
         }
-      }
-      const Vec<D> x_old(x_old0, x_old1);
-      if constexpr (Mixture) {
-        if constexpr (G::has_hoop_terms) {
-          const Vec<NC> qp(q2[0], q2[1], q3);
-          div_q += G::div_extra(qp, x_old);
+        const Vec<D> x_old(x_old0, x_old1);
+        if constexpr (Mixture) {
+          if constexpr (G::has_hoop_terms) {
+            const Vec<NC> qp(q2[0], q2[1], q3);
+            div_q += G::div_extra(qp, x_old);
+          }
+          body.phi[p] = 1.0 - n_p;
+          body.div_q_1_s[p] = div_q;
         }
+        // L at the start-of-step position from the grid velocity field (hoop entries use Σ N v_i).
+        const double trL = G::write_velocity_gradient(Ls[p].data(), g[0], g[1], x_old, v_pic);
+        vol_arg[j] = dt_s * trL;
+        double vsum = v_new[0];
+        for (int c = 1; c < NC; ++c) vsum += v_new[c];
+        kin_sum[j] = (xn0 + xn1) + vsum;
+        continue;
+      }
+      double v_pic[NC], dv[NC], q_p[NC], grad_v[D][NC], B[D][NC];  // column-major like Mat<NC, D>
+      for (int c = 0; c < 2; ++c) {
+        v_pic[c] = vp2[c];
+        dv[c] = dv2[c];
+        q_p[c] = q2[c];
+        for (int a = 0; a < D; ++a) {
+          grad_v[a][c] = gv2[a][c];
+          B[a][c] = B2[a][c];
+        }
+      }
+      if constexpr (NC == 3) {
+        v_pic[2] = vp3;
+        dv[2] = dv3;
+        q_p[2] = q3;
+        for (int a = 0; a < D; ++a) {
+          grad_v[a][2] = gv3[a];
+          B[a][2] = B3[a];
+        }
+      }
+      const Vec<D> x_old = xs[p];
+      Vec<D> x;
+      for (int a = 0; a < D; ++a) x[a] = x_old[a] + dt_s * v_pic[a];
+      grid.wrap(x);
+      xs[p] = x;
+      const Eigen::Map<const Vec<NC>> vpic(v_pic);
+      const Eigen::Map<const Mat<NC, D>> gv(&grad_v[0][0]);
+      if constexpr (Apic) {
+        vs[p] = vpic;
+        if constexpr (ByGrad) {
+          Cs[p] = gv;
+        } else {
+          Mat<NC, D> C;
+          for (int a = 0; a < D; ++a) {
+            const double s = inv_D[p * D + a];
+            for (int c = 0; c < NC; ++c) C(c, a) = B[a][c] * s;
+          }
+          Cs[p] = C;
+        }
+      } else {
+        Vec<NC> v;
+        for (int c = 0; c < NC; ++c) v[c] = alpha * (vs[p][c] + dv[c]) + (1.0 - alpha) * v_pic[c];
+        vs[p] = v;
+      }
+      if constexpr (Mixture) {
+        if constexpr (G::has_hoop_terms) div_q += G::div_extra(Eigen::Map<const Vec<NC>>(q_p), x_old);
         body.phi[p] = 1.0 - n_p;
         body.div_q_1_s[p] = div_q;
       }
       // L at the start-of-step position from the grid velocity field (hoop entries use Σ N v_i).
-      const double trL = G::write_velocity_gradient(Ls[p].data(), g[0], g[1], x_old, v_pic);
-      const double V = Vs[p] * std::exp(dt_s * trL);  // step 7: V ← V exp(Δt tr L)
+      const Mat3 L = G::velocity_gradient(gv, x_old, vpic);
+      Ls[p] = L;
+      vol_arg[j] = dt_s * L.trace();
+      kin_sum[j] = x.sum() + vs[p].sum();
+    }
+    numerics::exp_block(vol_arg, vol_factor);
+    for (int j = 0; j < nb; ++j) {
+      const std::int64_t p = p0 + j;
+      const double V = Vs[p] * vol_factor[j];  // step 7: V ← V exp(Δt tr L)
       Vs[p] = V;
-      double vsum = v_new[0];
-      for (int c = 1; c < NC; ++c) vsum += v_new[c];
       // NaN/Inf guard of the new x, v, V (a sum is finite only if every term is)
-      if (!std::isfinite(((xn0 + xn1) + vsum) + V)) bad = std::min(bad, p);
-      continue;
+      if (!std::isfinite(kin_sum[j] + V)) bad = std::min(bad, p);
     }
-    double v_pic[NC], dv[NC], q_p[NC], grad_v[D][NC], B[D][NC];  // column-major like Mat<NC, D>
-    for (int c = 0; c < 2; ++c) {
-      v_pic[c] = vp2[c];
-      dv[c] = dv2[c];
-      q_p[c] = q2[c];
-      for (int a = 0; a < D; ++a) {
-        grad_v[a][c] = gv2[a][c];
-        B[a][c] = B2[a][c];
-      }
-    }
-    if constexpr (NC == 3) {
-      v_pic[2] = vp3;
-      dv[2] = dv3;
-      q_p[2] = q3;
-      for (int a = 0; a < D; ++a) {
-        grad_v[a][2] = gv3[a];
-        B[a][2] = B3[a];
-      }
-    }
-    const Vec<D> x_old = xs[p];
-    Vec<D> x;
-    for (int a = 0; a < D; ++a) x[a] = x_old[a] + dt_s * v_pic[a];
-    grid.wrap(x);
-    xs[p] = x;
-    const Eigen::Map<const Vec<NC>> vpic(v_pic);
-    const Eigen::Map<const Mat<NC, D>> gv(&grad_v[0][0]);
-    if constexpr (Apic) {
-      vs[p] = vpic;
-      if constexpr (ByGrad) {
-        Cs[p] = gv;
-      } else {
-        Mat<NC, D> C;
-        for (int a = 0; a < D; ++a) {
-          const double s = inv_D[p * D + a];
-          for (int c = 0; c < NC; ++c) C(c, a) = B[a][c] * s;
-        }
-        Cs[p] = C;
-      }
-    } else {
-      Vec<NC> v;
-      for (int c = 0; c < NC; ++c) v[c] = alpha * (vs[p][c] + dv[c]) + (1.0 - alpha) * v_pic[c];
-      vs[p] = v;
-    }
-    if constexpr (Mixture) {
-      if constexpr (G::has_hoop_terms) div_q += G::div_extra(Eigen::Map<const Vec<NC>>(q_p), x_old);
-      body.phi[p] = 1.0 - n_p;
-      body.div_q_1_s[p] = div_q;
-    }
-    // L at the start-of-step position from the grid velocity field (hoop entries use Σ N v_i).
-    const Mat3 L = G::velocity_gradient(gv, x_old, vpic);
-    Ls[p] = L;
-    const double V = Vs[p] * std::exp(dt_s * L.trace());  // step 7: V ← V exp(Δt tr L)
-    Vs[p] = V;
-    // NaN/Inf guard of the new x, v, V (a sum is finite only if every term is)
-    if (!std::isfinite((x.sum() + vs[p].sum()) + V)) bad = std::min(bad, p);
   }
   return bad;
 }
