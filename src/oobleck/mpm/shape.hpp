@@ -59,6 +59,8 @@ struct LinearKernel {
 struct QuadraticBSplineKernel {
   static constexpr int support = 3;
   static constexpr bool apic_by_gradient = false;
+  /// h²/D_p: the second moment of the weights is h²/4 wherever the point is (make_stencil).
+  static constexpr double apic_inv_inertia_h2 = 4.0;
   /// As LinearKernel::axes.
   template <class T>
   void axes(const T& xi, T& base, T* w, T* dw) const {
@@ -83,6 +85,8 @@ struct QuadraticBSplineKernel {
 struct CubicBSplineKernel {
   static constexpr int support = 4;
   static constexpr bool apic_by_gradient = false;
+  /// h²/D_p: the second moment of the weights is h²/3 wherever the point is (make_stencil).
+  static constexpr double apic_inv_inertia_h2 = 3.0;
   void operator()(double xi, int& base, double* w, double* dw) const {
     base = static_cast<int>(std::floor(xi)) - 1;
     const double f = xi - base;  // in [1, 2); r_j = f − j is the signed distance to node j
@@ -360,8 +364,14 @@ inline bool make_stencil(const Grid<D>& grid, const StencilGrid<D>& sg, const Ke
     Eigen::Map<A>(s.dw[j]) = dw[j] * sg.inv_h;
     Eigen::Map<A>(s.off[j]) = off;
   }
-  const A inv_m2 = 1.0 / m2;  // all lanes in one division (1/0 = inf is not selected)
-  inv_D = (m2 > 0.0).select(inv_m2, 0.0).matrix();
+  if constexpr (requires { Kernel::apic_inv_inertia_h2; }) {
+    // B-splines: APIC's D_p is the same at every point (h²/4 quadratic, h²/3 cubic; Jiang et al.
+    // 2015), so no division per point (m2 above is then dead code)
+    inv_D.setConstant(Kernel::apic_inv_inertia_h2 * (sg.inv_h * sg.inv_h));
+  } else {
+    const A inv_m2 = 1.0 / m2;  // all lanes in one division (1/0 = inf is not selected)
+    inv_D = (m2 > 0.0).select(inv_m2, 0.0).matrix();
+  }
   // Storage indices of base … base + S − 1 (= grid.storage_index, one modulo per axis).
   bool ok = true;
   for (int a = 0; a < D; ++a) {
