@@ -3,9 +3,11 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <iterator>
 #include <random>
 
 #include "oobleck/material/drag.hpp"
+#include "oobleck/numerics/vector_math.hpp"
 
 namespace m = oobleck::material;
 
@@ -160,5 +162,36 @@ TEST(SemiImplicitDrag, ExponentialRelaxationRecoveredAsDtShrinks) {
       EXPECT_NEAR(prev_err / err, 2.0, 0.1);  // first order in Δt
     }
     prev_err = err;
+  }
+}
+
+TEST(Drag, BlockMatchesTabulatedValuesAndScalarLaws) {
+  // the solver's nodal call (powers in vector lanes) against the 30-digit table, and the scalar
+  // laws exactly where no power is taken (Re = 0, Carman–Kozeny, Re term off)
+  constexpr int N = oobleck::numerics::kMathBlock;
+  m::DragParams p;
+  p.d_m = 1e-5;
+  p.eta_0_Pa_s = 2e-3;
+  const double scale = 18.0 * p.eta_0_Pa_s / (p.d_m * p.d_m);
+  double phi[N], Re[N], C[N];
+  for (int j = 0; j < N; ++j) {
+    const Tab& t = kBeetstra[j % std::size(kBeetstra)];
+    phi[j] = t.phi;
+    Re[j] = t.Re;
+  }
+  m::drag_coefficient_per_volume_block(p, phi, Re, C);
+  for (int j = 0; j < N; ++j) {
+    const Tab& t = kBeetstra[j % std::size(kBeetstra)];
+    EXPECT_NEAR(C[j] / (scale * t.phi * (1.0 - t.phi)), t.F, 1e-12 * t.F) << "phi=" << t.phi << " Re=" << t.Re;
+    if (t.Re == 0.0) {
+      EXPECT_EQ(C[j], m::drag_coefficient_per_volume(p, t.phi, 0.0));
+    }
+  }
+  for (auto law : {m::DragLaw::CarmanKozeny, m::DragLaw::Beetstra}) {
+    m::DragParams q = p;
+    q.law = law;
+    q.use_reynolds = false;
+    m::drag_coefficient_per_volume_block(q, phi, Re, C);
+    for (int j = 0; j < N; ++j) EXPECT_EQ(C[j], m::drag_coefficient_per_volume(q, phi[j], Re[j]));
   }
 }

@@ -27,20 +27,32 @@ struct DragParams {
   bool use_reynolds = true;        ///< Beetstra only: include the finite-Re term (false ⇒ Re = 0)
 };
 
-/// Beetstra's normalized drag F̂(φ, Re) [-] (E29).
-inline double beetstra_F(double phi, double Re) {
+/// The exponents of the two powers in Beetstra's Re term, as arguments of exp given ln Re:
+/// Re^{−0.343} = exp(beetstra_arg1(ln Re)), 10^{3φ} Re^{−(1+4φ)/2} = exp(beetstra_arg2(φ, ln Re)).
+inline double beetstra_arg1(double ln_Re) { return -0.343 * ln_Re; }
+inline double beetstra_arg2(double phi, double ln_Re) {
+  return 3.0 * phi * std::numbers::ln10 - 0.5 * (1.0 + 4.0 * phi) * ln_Re;
+}
+
+/// Beetstra's F̂ (E29) given the two powers of its Re term (unused for Re <= 0):
+/// r1 = Re^{−0.343}, r2 = 10^{3φ} Re^{−(1+4φ)/2}.
+inline double beetstra_F_with_powers(double phi, double Re, double r1, double r2) {
   const double n = 1.0 - phi;
   double F = 10.0 * phi / (n * n) + n * n * (1.0 + 1.5 * std::sqrt(phi));
   if (Re > 0.0) {
-    // The powers through one logarithm and two exponentials (instead of three pow calls: the
-    // nodal drag is evaluated at every mixture node and step); relative difference < 2e-14 for
-    // 1e-12 < Re < 1e3.
-    const double ln_Re = std::log(Re);
-    const double num = 1.0 / n + 3.0 * phi * n + 8.4 * std::exp(-0.343 * ln_Re);
-    const double den = 1.0 + std::exp(3.0 * phi * std::numbers::ln10 - 0.5 * (1.0 + 4.0 * phi) * ln_Re);
+    const double num = 1.0 / n + 3.0 * phi * n + 8.4 * r1;
+    const double den = 1.0 + r2;
     F += 0.413 * Re / (24.0 * n * n) * num / den;
   }
   return F;
+}
+
+/// Beetstra's normalized drag F̂(φ, Re) [-] (E29). The powers through one logarithm and two
+/// exponentials (instead of three pow calls); relative difference < 2e-14 for 1e-12 < Re < 1e3.
+inline double beetstra_F(double phi, double Re) {
+  if (!(Re > 0.0)) return beetstra_F_with_powers(phi, Re, 0.0, 0.0);
+  const double ln_Re = std::log(Re);
+  return beetstra_F_with_powers(phi, Re, std::exp(beetstra_arg1(ln_Re)), std::exp(beetstra_arg2(phi, ln_Re)));
 }
 
 /// Carman–Kozeny drag written as E29's F̂ [-].
@@ -69,6 +81,11 @@ inline double drag_F(const DragParams& p, double phi, double Re) {
 inline double drag_coefficient_per_volume(const DragParams& p, double phi, double Re) {
   return 18.0 * phi * (1.0 - phi) * p.eta_0_Pa_s / (p.d_m * p.d_m) * drag_F(p, phi, Re);
 }
+
+/// drag_coefficient_per_volume of numerics::kMathBlock (φ, Re) pairs [Pa s/m²], the powers of
+/// Beetstra's Re term in vector lanes (numerics/vector_math.hpp; drag.cpp): the nodal drag of a
+/// step, a log and two exps per mixture node.
+void drag_coefficient_per_volume_block(const DragParams& p, const double* phi, const double* Re, double* C_V);
 
 /// Semi-implicit nodal drag (model.md §5). Given the nodal masses m_s, m_f [kg], the predicted
 /// velocities v_s*, v_f* [m/s] that include every other force of the step, the nodal drag

@@ -24,6 +24,7 @@
 
 #include "oobleck/core/error.hpp"
 #include "oobleck/material/drag.hpp"
+#include "oobleck/numerics/vector_math.hpp"
 #include "oobleck/mpm/body.hpp"
 #include "oobleck/mpm/boundary.hpp"
 #include "oobleck/mpm/contact.hpp"
@@ -331,28 +332,52 @@ class Solver {
     const auto& mx = opt_.mixture;
     const int nn = f.nodes();
     porosity_.resize(static_cast<std::size_t>(nn));
+    // Nodes in blocks: porosity, buoyancy split and predictions node by node, then the drag
+    // coefficients of the block's mixture nodes at once (their powers in vector lanes), then the
+    // semi-implicit drag.
+    constexpr int kBlock = numerics::kMathBlock;
+    const int blocks = (nn + kBlock - 1) / kBlock;
 #pragma omp parallel for schedule(static) if (nn >= kParallelMinNodes / 32)  // ~20 ns per node (drag)
-    for (int i = 0; i < nn; ++i) {
-      const double V = f.volume_m3[i], ms = grains ? s.mass_kg[i] : 0.0, mf = f.mass_kg[i];
-      double n = 1.0;
-      if (V > 0.0 && ms > 0.0) n = std::clamp(1.0 - ms / (mx.rho_s_kg_m3 * V), mx.min_porosity, 1.0);
-      porosity_[i] = n;
-      const Vec<NC> Fp = f.pressure_force_N[i] - V * mx.background_pressure_gradient_Pa_m;
-      f.force_N[i] += n * Fp;
-      predict_node(f, i, dt);
-      if (!grains) continue;
-      s.force_N[i] += (1.0 - n) * Fp;
-      predict_node(s, i, dt);
-      if (!(ms > 0.0 && mf > 0.0 && V > 0.0)) continue;
-      const Vec<NC> dv = s.velocity[i] - f.velocity[i];
-      const double rho_f = mf / (n * V);
-      const double Re = material::drag_reynolds(dv.norm(), n, rho_f, mx.drag.d_m, mx.drag.eta_0_Pa_s);
-      const double C = V * material::drag_coefficient_per_volume(mx.drag, 1.0 - n, Re);
-      const Vec<NC> Fd = material::semi_implicit_drag_force(ms, mf, s.velocity[i], f.velocity[i], C, dt);
-      s.velocity[i] -= (dt / ms) * Fd;
-      f.velocity[i] += (dt / mf) * Fd;
-      s.force_N[i] -= Fd;  // kept for output/diagnostics
-      f.force_N[i] += Fd;
+    for (int blk = 0; blk < blocks; ++blk) {
+      const int i0 = blk * kBlock, nb = std::min(kBlock, nn - i0);
+      double phi_b[kBlock], Re_b[kBlock], C_V[kBlock];
+      bool drag[kBlock];
+      for (int j = 0; j < kBlock; ++j) {
+        phi_b[j] = 0.5;  // (a harmless stand-in for nodes without drag)
+        Re_b[j] = 0.0;
+        drag[j] = false;
+      }
+      for (int j = 0; j < nb; ++j) {
+        const int i = i0 + j;
+        const double V = f.volume_m3[i], ms = grains ? s.mass_kg[i] : 0.0, mf = f.mass_kg[i];
+        double n = 1.0;
+        if (V > 0.0 && ms > 0.0) n = std::clamp(1.0 - ms / (mx.rho_s_kg_m3 * V), mx.min_porosity, 1.0);
+        porosity_[i] = n;
+        const Vec<NC> Fp = f.pressure_force_N[i] - V * mx.background_pressure_gradient_Pa_m;
+        f.force_N[i] += n * Fp;
+        predict_node(f, i, dt);
+        if (!grains) continue;
+        s.force_N[i] += (1.0 - n) * Fp;
+        predict_node(s, i, dt);
+        if (!(ms > 0.0 && mf > 0.0 && V > 0.0)) continue;
+        const Vec<NC> dv = s.velocity[i] - f.velocity[i];
+        const double rho_f = mf / (n * V);
+        drag[j] = true;
+        phi_b[j] = 1.0 - n;
+        Re_b[j] = material::drag_reynolds(dv.norm(), n, rho_f, mx.drag.d_m, mx.drag.eta_0_Pa_s);
+      }
+      material::drag_coefficient_per_volume_block(mx.drag, phi_b, Re_b, C_V);
+      for (int j = 0; j < nb; ++j) {
+        if (!drag[j]) continue;
+        const int i = i0 + j;
+        const double ms = s.mass_kg[i], mf = f.mass_kg[i];
+        const double C = f.volume_m3[i] * C_V[j];
+        const Vec<NC> Fd = material::semi_implicit_drag_force(ms, mf, s.velocity[i], f.velocity[i], C, dt);
+        s.velocity[i] -= (dt / ms) * Fd;
+        f.velocity[i] += (dt / mf) * Fd;
+        s.force_N[i] -= Fd;  // kept for output/diagnostics
+        f.force_N[i] += Fd;
+      }
     }
   }
 
