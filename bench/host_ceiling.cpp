@@ -1,12 +1,12 @@
-// The host's own ceiling for multi-threaded speed-up, without oobleck: how much more work per
-// second two (or more) threads of *perfectly* parallel loops get than one on this machine.
+// What a second thread gains on this host, without oobleck: how much more work per second two
+// threads of *perfectly* parallel loops get than one on this machine.
 //
 // The two-thread target of issue 4 (≥ 1.7× the one-thread updates/s) presumes a machine on which
 // independent work doubles with a second core. Shared or virtualised hosts need not give that:
 // when two cores are busy the clock drops (turbo), and cores may share caches, memory paths or,
 // behind a hypervisor, a physical core. Each kernel here has no sharing at all between threads
-// (private arrays, no atomics, no barriers inside the timed loop), so its aggregate rate on N
-// threads over its rate on one is the most any program can gain on this host:
+// (private arrays, no atomics, no barriers inside the timed loop), so its aggregate rate on two
+// threads over its rate on one is what that kind of loop can gain on this host at that minute:
 //
 //   compute    independent multiply-add chains in registers (bound by the FP units and the clock)
 //   stream_l2  a = b + s c on private arrays of 3 × 32 KiB per thread (fits each core's L2)
@@ -14,10 +14,12 @@
 //   stream_mem the same on 3 × 32 MiB per thread (main memory)
 //
 // Read the `items_per_second` column: it is the rate summed over the threads (Google Benchmark adds
-// the items of all threads and divides by the wall time). Compare it with the one-thread row; the
-// ratio for `compute` bounds the speed-up of compute-bound phases (the granular law), those of the
-// stream kernels bound the memory-bound ones (P2G, G2P). `bash bench/host_ceiling.sh` prints the
-// ratios; docs/mpm.md "Performance" gives them for the machines the project was measured on.
+// the items of all threads and divides by the wall time). Compare it with the one-thread row: the
+// ratio for `compute` bounds the speed-up of compute-bound work (no program beats a loop with
+// nothing shared); the stream ratios are reference points for memory-bound loops (P2G and G2P
+// are partly that). `bash bench/host_ceiling.sh` prints the ratios; docs/mpm.md "Performance"
+// gives them for the machine of the tenth session. They vary from minute to minute on shared
+// hosts: measure them in the same minutes as the runs they are compared with.
 #include <benchmark/benchmark.h>
 
 #include <array>

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# The host's ceiling for multi-threaded speed-up (bench/host_ceiling.cpp): runs the kernels on 1
-# and 2 threads and prints, per kernel, the aggregate rate on 2 threads over the rate on 1. No
-# program gains more from a second thread on this machine than the `compute` ratio in its
-# compute-bound parts, or than the stream ratios in its memory-bound parts.
+# What a second thread gains on this host (bench/host_ceiling.cpp): runs the kernels on 1 and 2
+# threads and prints, per kernel, the aggregate rate on 2 threads over the rate on 1. No program
+# gains more from a second thread than the `compute` ratio in its compute-bound parts; the stream
+# ratios are reference points for memory-bound loops. The ratios drift on shared hosts.
 #   usage: bash bench/host_ceiling.sh [BUILD_DIR=build/release]
 set -euo pipefail
 build=$(realpath "${1:-build/release}")

@@ -167,7 +167,8 @@ TEST(SemiImplicitDrag, ExponentialRelaxationRecoveredAsDtShrinks) {
 
 TEST(Drag, BlockMatchesTabulatedValuesAndScalarLaws) {
   // the solver's nodal call (powers in vector lanes) against the 30-digit table, and the scalar
-  // laws exactly where no power is taken (Re = 0, Carman–Kozeny, Re term off)
+  // laws where no power is taken (Re = 0, Carman–Kozeny, Re term off) to round-off: the library
+  // may run its x86-64-v3 variant, which contracts a*b+c where this file does not
   constexpr int N = oobleck::numerics::kMathBlock;
   m::DragParams p;
   p.d_m = 1e-5;
@@ -184,7 +185,8 @@ TEST(Drag, BlockMatchesTabulatedValuesAndScalarLaws) {
     const Tab& t = kBeetstra[j % std::size(kBeetstra)];
     EXPECT_NEAR(C[j] / (scale * t.phi * (1.0 - t.phi)), t.F, 1e-12 * t.F) << "phi=" << t.phi << " Re=" << t.Re;
     if (t.Re == 0.0) {
-      EXPECT_EQ(C[j], m::drag_coefficient_per_volume(p, t.phi, 0.0));
+      const double ref = m::drag_coefficient_per_volume(p, t.phi, 0.0);
+      EXPECT_NEAR(C[j], ref, 1e-14 * ref) << "phi=" << t.phi;
     }
   }
   for (auto law : {m::DragLaw::CarmanKozeny, m::DragLaw::Beetstra}) {
@@ -192,6 +194,9 @@ TEST(Drag, BlockMatchesTabulatedValuesAndScalarLaws) {
     q.law = law;
     q.use_reynolds = false;
     m::drag_coefficient_per_volume_block(q, phi, Re, C);
-    for (int j = 0; j < N; ++j) EXPECT_EQ(C[j], m::drag_coefficient_per_volume(q, phi[j], Re[j]));
+    for (int j = 0; j < N; ++j) {
+      const double ref = m::drag_coefficient_per_volume(q, phi[j], Re[j]);
+      EXPECT_NEAR(C[j], ref, 1e-14 * ref) << "phi=" << phi[j] << " Re=" << Re[j];
+    }
   }
 }

@@ -173,6 +173,8 @@ TEST(RunScenes, FusedNonFiniteGuardsAgreeWithTheFullScan) {
   b.set_law(std::make_unique<LinearElasticLaw<PlaneStrain>>(ep));
   for (int i = 0; i < 8; ++i)
     for (int j = 0; j < 8; ++j) b.add_point(Vec<2>(0.3 + 0.05 * (i + 0.5), 0.3 + 0.05 * (j + 0.5)), 0.0025, 1000.0);
+  // three more, away from the block: a tail block of G2P's blocks of 32 (67 points)
+  for (int i = 0; i < 3; ++i) b.add_point(Vec<2>(0.8, 0.15 + 0.05 * i), 0.0025, 1000.0);
   EXPECT_EQ(s.first_non_finite_kinematics(0), kNotChecked);  // no step yet
   s.step();
   EXPECT_EQ(s.first_non_finite_kinematics(0), kAllFinite);

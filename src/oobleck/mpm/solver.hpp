@@ -366,6 +366,9 @@ class Solver {
         phi_b[j] = 1.0 - n;
         Re_b[j] = material::drag_reynolds(dv.norm(), n, rho_f, mx.drag.d_m, mx.drag.eta_0_Pa_s);
       }
+      bool any_drag = false;
+      for (int j = 0; j < nb; ++j) any_drag = any_drag || drag[j];
+      if (!any_drag) continue;
       material::drag_coefficient_per_volume_block(mx.drag, phi_b, Re_b, C_V);
       for (int j = 0; j < nb; ++j) {
         if (!drag[j]) continue;

@@ -11,16 +11,13 @@
 namespace oobleck::numerics {
 
 /// Values per block: a multiple of every vector width (2 for SSE2, 4 for AVX2, 8 for AVX-512), so
-/// that no value of a block falls into a scalar remainder loop.
+/// that no value of a block falls into a scalar remainder loop (GCC 12, -O1 to -O3).
 inline constexpr int kMathBlock = 32;
 
-/// y[i] = exp(x[i]) for i < kMathBlock.
+/// y[i] = exp(x[i]) for i < kMathBlock (x and y must not overlap).
 void exp_block(const double* x, double* y);
 
-/// y[i] = log(x[i]) for i < kMathBlock.
+/// y[i] = log(x[i]) for i < kMathBlock (x and y must not overlap).
 void log_block(const double* x, double* y);
-
-/// Whether the blocks use glibc's libmvec (else they are loops of std::exp and std::log).
-bool vector_math_uses_libmvec();
 
 }  // namespace oobleck::numerics
