@@ -1,13 +1,14 @@
 #pragma once
 // exp and log over fixed-size blocks of values, several lanes at a time, through glibc's vector
 // math library (libmvec) where the build has it (vector_math.cpp). The hot loops of a step take
-// one exp or log per point (G2P's volume update, the fluid's E26–E27); called one at a time, each
-// is a libm call of ~11 ns on the benchmark hosts, in blocks ~4 ns per value.
+// one exp or log per point or node (G2P's volume update, the fluid's E26–E27, E8's powers in the
+// granular law, E29's drag); called one at a time, each is a libm call of ~11 ns on the
+// benchmark host, in blocks ~4 ns per value.
 //
 // Every value of a block goes through the same function, so a point's result does not depend on
-// its position in a block or on the thread count. The results are those of libmvec: within 4 ulp
-// of the correctly rounded value (glibc manual, "Errors in Math Functions"), not necessarily the
-// bits of libm's scalar exp and log (tests/numerics).
+// its position in a block or on the thread count. The results are those of libmvec, whose stated
+// accuracy is 4 ulp: not necessarily the bits of libm's scalar exp and log (tests/numerics checks
+// the blocks within 4 ulp of them).
 namespace oobleck::numerics {
 
 /// Values per block: a multiple of every vector width (2 for SSE2, 4 for AVX2, 8 for AVX-512), so
