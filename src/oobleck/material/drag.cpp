@@ -20,8 +20,7 @@ void drag_coefficient_per_volume_block(const DragParams& p, const double* phi, c
   numerics::exp_block(a1, r1);
   numerics::exp_block(a2, r2);
   for (int j = 0; j < N; ++j)  // as drag_coefficient_per_volume
-    C_V[j] = 18.0 * phi[j] * (1.0 - phi[j]) * p.eta_0_Pa_s / (p.d_m * p.d_m) *
-             beetstra_F_with_powers(phi[j], Re[j], r1[j], r2[j]);
+    C_V[j] = drag_stokes_prefactor(p, phi[j]) * beetstra_F_with_powers(phi[j], Re[j], r1[j], r2[j]);
 }
 
 }  // namespace oobleck::material

@@ -76,10 +76,15 @@ inline double drag_F(const DragParams& p, double phi, double Re) {
   }
 }
 
+/// E29's prefactor 18 φ(1−φ) η_0/d² [Pa s/m²]: C_V = prefactor · F̂.
+inline double drag_stokes_prefactor(const DragParams& p, double phi) {
+  return 18.0 * phi * (1.0 - phi) * p.eta_0_Pa_s / (p.d_m * p.d_m);
+}
+
 /// E29 drag coefficient per unit mixture volume C_V = 18 φ(1−φ) η_0/d² F̂ [Pa s/m² = kg/(m³ s)].
 /// Multiply by the nodal mixture volume V_i to get the nodal C_i [kg/s].
 inline double drag_coefficient_per_volume(const DragParams& p, double phi, double Re) {
-  return 18.0 * phi * (1.0 - phi) * p.eta_0_Pa_s / (p.d_m * p.d_m) * drag_F(p, phi, Re);
+  return drag_stokes_prefactor(p, phi) * drag_F(p, phi, Re);
 }
 
 /// drag_coefficient_per_volume of numerics::kMathBlock (φ, Re) pairs [Pa s/m²], the powers of

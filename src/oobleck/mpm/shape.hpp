@@ -356,17 +356,18 @@ inline bool make_stencil(const Grid<D>& grid, const StencilGrid<D>& sg, const Ke
       }
     }
   }
+  // B-splines: APIC's D_p is the same at every point (h²/4 quadratic, h²/3 cubic; Jiang et al.
+  // 2015), so no second moment and no division per point
+  constexpr bool constant_inertia = requires { Kernel::apic_inv_inertia_h2; };
   A m2 = A::Zero();
   for (int j = 0; j < S; ++j) {
     const A off = ((basef + static_cast<double>(j)) - xi) * sg.h;
-    m2 += w[j] * off * off;
+    if constexpr (!constant_inertia) m2 += w[j] * off * off;
     Eigen::Map<A>(s.w[j]) = w[j];
     Eigen::Map<A>(s.dw[j]) = dw[j] * sg.inv_h;
     Eigen::Map<A>(s.off[j]) = off;
   }
-  if constexpr (requires { Kernel::apic_inv_inertia_h2; }) {
-    // B-splines: APIC's D_p is the same at every point (h²/4 quadratic, h²/3 cubic; Jiang et al.
-    // 2015), so no division per point (m2 above is then dead code)
+  if constexpr (constant_inertia) {
     inv_D.setConstant(Kernel::apic_inv_inertia_h2 * (sg.inv_h * sg.inv_h));
   } else {
     const A inv_m2 = 1.0 / m2;  // all lanes in one division (1/0 = inf is not selected)
