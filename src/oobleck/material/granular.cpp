@@ -150,8 +150,6 @@ inline void elastic_trial(const T9& S, const T9& D, const T9& W, double dt, doub
 // ---- The f_1-only branch of the return map in u = I_m (docs/granular.md), shared by the scalar
 // solve and the lanes of advance_batch so that both do the same arithmetic. Both sides of every
 // select are computed (no division under a condition), so the lane loop vectorises.
-}  // namespace
-namespace granular_detail {
 struct F1Consts {
   double Kdt, Gdt, two_eta, d2_rho_s, K_3, mu_1, mu_2, b;
 };
@@ -164,11 +162,7 @@ struct Compressive {
   F1Value e_lo;
   double g, p, tau, xi2;
 };
-}  // namespace granular_detail
-using granular_detail::Compressive;
-using granular_detail::F1Consts;
-using granular_detail::F1Value;
-namespace {
+
 
 /// E20 mu_q(I_m) = mu_1 + (mu_2 - mu_1) I_m/(I_m + b) (GranularLaw::mu_q, mu_2 for b = 0) and its
 /// derivative, without branches (both sides computed) so that the lane loops vectorise.
@@ -259,6 +253,67 @@ inline void compressive(const F1Consts& c, double phi, double phi_m, double a, d
 }
 
 
+/// Start of the f_1-only Newton solve in u (return_map): the bracket's upper end hi and the first
+/// iterate x in (u_eq, hi). Upper end: with beta >= 0, gamma_dot(u) >= the beta = 0 root, so
+/// gamma_dot(u_hi) >= gamma_max = tau_tr/(G dt) when Q(gamma_max)/u_hi^2 <= p_tr; there
+/// R <= -(mu_p + beta) p < 0. First iterate: the rigid-plastic, viscous balance
+/// tau_tr/p_tr = mu_q + beta(u) + (5/4)(phi/a) u (G dt, K dt dropped), a quadratic
+/// c1 a u^2 + (c1 - r a) u - (r + K_3 phi_m) = 0; near a steady state (the root just above u_eq) a
+/// Newton step from u_eq when it lands lower. Both sides of every select computed (lanes).
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void f1_start(const F1Consts& c, double mu0, double phi, double phi_m, double a, double visc, double p_tr,
+                     double tau_tr, double u_eq, double g_max, const F1Value& e_lo, double& x, double& hi) {
+  const double e_lo_dR = f1_slope(c, phi_m, a, visc, p_tr, u_eq, e_lo);
+  const double lo = u_eq;
+  const double Q_max = g_max * (g_max * c.d2_rho_s + c.two_eta);  // E19 Q(gamma_max)
+  const double u_max = std::sqrt(Q_max / p_tr);
+  hi = (u_eq < u_max ? u_max : u_eq) * (1.0 + 1e-12) + 1e-300;  // std::max(u_eq, u_max)
+  const double c1 = 1.25 * phi / a;
+  const double r = tau_tr / p_tr - mu0 - c.K_3 * phi;
+  const double qa = c1 * a, qb = c1 - r * a, qc = -(r + c.K_3 * phi_m);
+  const double disc = qb * qb - 4.0 * qa * qc;
+  const double sq = std::sqrt(disc);
+  const double x_a = (-qb + sq) / (2.0 * qa), x_b = -2.0 * qc / (qb + sq);  // the positive root, stably
+  const double mid = 0.5 * (lo + hi);
+  const double x_q = ((qc < 0.0) & (disc >= 0.0)) ? (qb <= 0.0 ? x_a : x_b) : mid;
+  const double x_in = ((x_q > lo) & (x_q < hi)) ? x_q : mid;
+  const double xn = lo - e_lo.R / e_lo_dR;
+  x = ((e_lo_dR < 0.0) & (xn > lo) & (xn < x_in)) ? xn : x_in;
+}
+
+/// Start of the p_tr <= 0 fast path's Newton solve on (gamma_dot, u) (return_map): gamma_dot_max and
+/// the inner start of the nested solve's pressure balance there (h >= 0): u at the largest possible
+/// p = p_tr + K dt K_3 phi gamma_dot and, for p_tr < 0, the u at which p -> 0+.
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void tension_start(const F1Consts& c, double phi_m, double a, double p_tr, double dil, double g_max,
+                          double& gg, double& uu) {
+  gg = g_max;
+  const double S = p_tr + dil * gg, ck = c.Kdt * gg;
+  const double u_q = std::sqrt((gg * (gg * c.d2_rho_s + c.two_eta)) / S);
+  const double u_0 = (phi_m * ck * c.K_3 / S - 1.0) / a;
+  uu = p_tr < 0.0 && u_q < u_0 ? u_0 : u_q;  // std::max(u_q, u_0) for p_tr < 0
+}
+
+/// E24 linearly implicit with the end-of-step tau_bar, gamma_dot^p: f = (f_n + dt H' f_m)/(1 + dt (H' + S')),
+/// H' = K_0 gamma_dot^p (tau_bar/tau*)^{3/2}, S' = K_0 (gamma_dot^p + tau_bar/eta_B + xi_dot_eps);
+/// `stiff` = dt (H' + S'). Branch-free (GranularLaw::finish and the lanes of advance_batch).
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline double structure_step(double K_0, double tau_star, double xi_dot_eps, double dt, double fn, double fm,
+                             double inv_eta_B, double tau, double g, double& stiff) {
+  const double x = tau / tau_star;
+  const double Hp = K_0 * g * x * std::sqrt(x);
+  const double Sp = K_0 * (g + tau * inv_eta_B + xi_dot_eps);
+  stiff = dt * (Hp + Sp);
+  const double v = (fn + dt * Hp * fm) / (1.0 + stiff);
+  return v < 0.0 ? 0.0 : (1.0 < v ? 1.0 : v);  // std::clamp(v, 0, 1)
+}
+
 /// Friction side of E21 at (gamma_dot, p, I_m): max((mu_p + beta) p, 0), with E20 written as
 /// mu_p p = mu_q(I_m) p + (5/2)(phi/a) eta_0 gamma_dot/I_m; beta from E18.
 inline double friction_of(const F1Consts& c, double phi, double phi_m, double a, double visc, double gg, double pp,
@@ -327,8 +382,7 @@ inline bool tension_accept(const F1Consts& c, double phi, double phi_m, double a
 }  // namespace
 
 GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_0, double dt, double p_tr,
-                                               double tau_tr, F1Job* defer, TensionJob* defer2,
-                                               const Compressive* pre) const {
+                                               double tau_tr) const {
   const double tol = options_.rel_tol;
   const int cap = options_.max_iter;
   // ---- E1, E2 with the structure used by this return map (f_n when staggered) ----
@@ -471,12 +525,9 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
     } else {
       // Fast path, parametrised by u = I_m >= u_eq (beta >= 0, xi_dot_2 = 0): f1_value, R(u)
       // decreasing in u (docs/granular.md). Its value at u_eq decides between f_1 + f_3 and f_1.
-      // (compressive(): that value and the f_1 + f_3 closed form below; advance_batch passes both
-      // in `pre`, computed for a block of points in lanes)
-      Compressive cm_own;
-      if (pre == nullptr)
-        compressive(c, phi, phi_m, a, visc, p_tr, tau_tr, u_eq, cm_own.e_lo, cm_own.g, cm_own.p, cm_own.tau, cm_own.xi2);
-      const Compressive& cm = pre != nullptr ? *pre : cm_own;
+      // (compressive(): that value and the f_1 + f_3 closed form below)
+      Compressive cm;
+      compressive(c, phi, phi_m, a, visc, p_tr, tau_tr, u_eq, cm.e_lo, cm.g, cm.p, cm.tau, cm.xi2);
       const F1Value& e_lo = cm.e_lo;
       if (e_lo.R <= 0.0 && u_eq > 0.0) {
         // -------- f_1 + f_3 (E21, E23 with K_4 = 0): beta = 0, I_m = u_eq; closed form ----------
@@ -488,35 +539,8 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
         regime = g > 0.0 ? GranularRegime::kShearCompaction : GranularRegime::kCompaction;
       } else {
         // -------- f_1 only: root of R(u) on [u_lo, u_hi] --------
-        const double e_lo_dR = f1_slope(c, phi_m, a, visc, p_tr, u_eq, e_lo);
-        double lo = u_eq, hi;
-        // Upper bracket: with beta >= 0, gamma_dot(u) >= the beta = 0 root, so gamma_dot(u_hi) >= gamma_max
-        // when Q(gamma_max)/u_hi^2 <= p_tr; there R <= -(mu_p + beta) p < 0.
-        hi = std::max(u_eq, std::sqrt(Q_of(g_max) / p_tr)) * (1.0 + 1e-12) + 1e-300;
-        // Initial guess: rigid-plastic, viscous balance tau_tr/p_tr = mu_q + beta(u) + (5/4)(phi/a) u
-        // (drop G dt, K dt): c1 a u^2 + (c1 - r a) u - (r + K_3 phi_m) = 0.
-        double x;
-        {
-          const double c1 = 1.25 * phi / a;
-          const double r = tau_tr / p_tr - mu0 - K_3_ * phi;
-          const double qa = c1 * a, qb = c1 - r * a, qc = -(r + K_3_ * phi_m);
-          const double disc = qb * qb - 4.0 * qa * qc;
-          x = (qc < 0.0 && disc >= 0.0) ? (qb <= 0.0 ? (-qb + std::sqrt(disc)) / (2.0 * qa)
-                                                      : -2.0 * qc / (qb + std::sqrt(disc)))
-                                        : 0.5 * (lo + hi);
-          if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
-          // Near a steady state the root sits just above u_eq: a Newton step from the lower end is better.
-          if (e_lo_dR < 0.0) {
-            const double xn = lo - e_lo.R / e_lo_dR;
-            if (xn > lo && xn < x) x = xn;
-          }
-        }
-        if (defer != nullptr) {  // advance_batch runs the Newton iterations in lanes
-          *defer = F1Job{phi, phi_m, a, visc, p_tr, tau_tr, x, lo, hi};
-          ReturnMap r;
-          r.deferred = true;
-          return r;
-        }
+        double lo = u_eq, hi, x;
+        f1_start(c, mu0, phi, phi_m, a, visc, p_tr, tau_tr, u_eq, g_max, e_lo, x, hi);
         F1Value e{};
         converged = false;
         for (iterations = 1; iterations <= cap; ++iterations) {
@@ -565,19 +589,8 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
       // otherwise (far from the root, ill-conditioned) the bracketed nested solve in gamma_dot.
       bool fast = false;
       {
-        double gg = g_max;
-        double uu = 0.0;
-        {
-          const double S = p_tr + dil * gg, ck = Kdt * gg;
-          uu = std::sqrt(Q_of(gg) / S);
-          if (p_tr < 0.0) uu = std::max(uu, (phi_m * ck * K_3_ / S - 1.0) / a);
-        }
-        if (defer2 != nullptr) {  // advance_batch runs the Newton iterations in lanes
-          *defer2 = TensionJob{phi, phi_m, a, visc, p_tr, tau_tr, g_max, gg, uu};
-          ReturnMap r;
-          r.deferred = true;
-          return r;
-        }
+        double gg, uu;
+        tension_start(c, phi_m, a, p_tr, dil, g_max, gg, uu);
         bool step_ok = false;
         for (int k = 1; k <= kTensionIterations; ++k) {
           ++iterations;
@@ -732,11 +745,7 @@ inline void GranularLaw::finish(GranularState& state, const Trial& t, ReturnMap 
   // Linearly implicit E24 step with end-of-step tau_bar, gamma_dot^p: f = (f_n + dt H' f_m)/(1 + dt (H' + S')),
   // H' = K_0 gamma_dot^p (tau_bar/tau*)^{3/2}, S' = K_0 (gamma_dot^p + tau_bar/eta_B + xi_dot_eps); `stiff` = dt (H' + S').
   auto f_next = [&](const ReturnMap& rr, double& stiff) {
-    const double x = rr.tau / tau_star_;
-    const double Hp = K_0_ * rr.g * x * std::sqrt(x);
-    const double Sp = K_0_ * (rr.g + rr.tau * inv_eta_B + xi_dot_eps_);
-    stiff = dt * (Hp + Sp);
-    return std::clamp((fn + dt * Hp * fm) / (1.0 + stiff), 0.0, 1.0);
+    return structure_step(K_0_, tau_star_, xi_dot_eps_, dt, fn, fm, inv_eta_B, rr.tau, rr.g, stiff);
   };
 
   // ---- the return map r with f_n (given), then the structure update ----
@@ -895,18 +904,218 @@ void run_lanes(int jobs, Load&& load, Step&& step, Settle&& settle) {
 
 }  // namespace
 
+namespace {
+
+// The branch of return_map a point takes, as a double (one element width in the lane loops).
+constexpr double kElasticTrial = 0.0, kClosedForm = 1.0, kF1Solve = 2.0, kSeparatedForm = 3.0, kTensionSolve = 4.0;
+
+/// What the lane loops of advance_batch need of the law and the step.
+struct BatchConsts {
+  F1Consts c;
+  double dt, G, K, eta_0, phi_j, phi_c, a_0, a_inf, mu0;
+  double K_0, tau_star, xi_dot_eps;
+  double stiff_max;   ///< finish() takes the implicit structure update above this dt (H' + S')
+  double phi_forced;  ///< finish() forces f = 1 from this phi on (kForceOne), else infinity
+  bool step_ok;       ///< step_inputs_valid(dt, eta_0)
+  const rheology::SteadyParams* steady;
+};
+
+/// One block of points in component-major arrays (a lane per point).
+struct BatchBlock {
+  static constexpr int kSize = 128;
+  double bS[9][kSize], bL[9][kSize], t_s[9][kSize];  // sigma_n, L, deviator of the E16 trial
+  double s_f[kSize], s_phi[kSize], s_p_tr[kSize], s_tau_tr[kSize], t_fm[kSize], t_inv_eta_B[kSize], ok[kSize];
+  // return_map's branch (kind), the f_1 + f_3 closed form, the solves' constants and starts
+  double kind[kSize], c_g[kSize], c_p[kSize], c_tau[kSize], c_xi2[kSize];
+  double phi_m[kSize], a[kSize], visc[kSize], lo[kSize], x[kSize], hi[kSize], g_max[kSize], tu[kSize], xi1[kSize];
+  double f1_trial[kSize], R_lo[kSize], dil_p[kSize];  // what decides the branch
+  // the return maps' results, and the ends of the updates
+  double r_tau[kSize], r_p[kSize], r_g[kSize], r_ok[kSize], e_f[kSize], e_fast[kSize], e_sig[9][kSize];
+};
+
+// The lane loops below are functions of their own: inside the (large) advance_batch, GCC 12 left
+// some of them scalar once the function had grown past a size.
+
+/// (1) The E16 trials (begin(): checks, trial, f_m) of the block's points.
+[[gnu::noinline]] void batch_trials(const BatchConsts& k, BatchBlock& b, int m, const Eigen::Matrix3d* sigma,
+                                    const Eigen::Matrix3d* L, const double* f, const double* phi) {
+  for (int i = 0; i < m; ++i) {
+    for (int q = 0; q < 9; ++q) {
+      b.bS[q][i] = sigma[i].data()[q];
+      b.bL[q][i] = L[i].data()[q];
+    }
+  }
+  const double dt = k.dt, G = k.G, K = k.K;
+  const bool step_ok = k.step_ok;
+#pragma omp simd
+  for (int i = 0; i < m; ++i) {
+    T9 Sx, Dx, Wx;
+    double pt, tt;
+    for (int q = 0; q < 9; ++q) Sx.v[q] = b.bS[q][i];
+    for (int jj = 0; jj < 3; ++jj) {
+      for (int ii = 0; ii < 3; ++ii) {
+        Dx.v[ii + 3 * jj] = 0.5 * (b.bL[ii + 3 * jj][i] + b.bL[jj + 3 * ii][i]);
+        Wx.v[ii + 3 * jj] = 0.5 * (b.bL[ii + 3 * jj][i] - b.bL[jj + 3 * ii][i]);
+      }
+    }
+    T9 sx;
+    elastic_trial(Sx, Dx, Wx, dt, G, K, sx, pt, tt);
+    const double ff = f[i], ph = phi[i];
+    const bool ok = step_ok & point_inputs_valid(ph, ff, Sx, Dx, Wx);  // as begin()
+    for (int q = 0; q < 9; ++q) b.t_s[q][i] = sx.v[q];
+    b.ok[i] = ok ? 1.0 : 0.0;  // (a bool store here stops the SSE2 vectorisation)
+    b.s_f[i] = ff;
+    b.s_phi[i] = ph;
+    b.s_p_tr[i] = ok ? pt : 1.0;
+    b.s_tau_tr[i] = ok ? tt : 1.0;
+    b.t_fm[i] = rheology::f_m(*k.steady, ph);
+  }
+}
+
+/// (2) return_map up to its Newton solves: the branch each point takes, the closed forms and the
+/// solves' starts, every candidate computed in every lane with the inline functions and
+/// expressions of return_map (so the same values, bit for bit).
+[[gnu::noinline]] void batch_classify(const BatchConsts& k, BatchBlock& b, int m) {
+  const F1Consts c = k.c;
+  const double phi_j = k.phi_j, phi_c = k.phi_c, a_0 = k.a_0, a_inf = k.a_inf, eta_0 = k.eta_0, mu0 = k.mu0;
+#pragma omp simd
+  for (int i = 0; i < m; ++i) {
+    const double ph = b.s_phi[i], p_tr = b.s_p_tr[i], tau_tr = b.s_tau_tr[i];
+    const double phi_m = phi_j + (phi_c - phi_j) * b.s_f[i];  // E1
+    const double a = a_0 + (a_inf - a_0) * b.s_f[i];          // E2
+    const double visc = 2.5 * ph / a * eta_0;
+    const double u_eq_below = (phi_m - ph) / (a * ph);
+    const double u_eq = ph < phi_m ? u_eq_below : 0.0;
+    const double g_max = tau_tr / c.Gdt;
+    const double dil = c.Kdt * c.K_3 * ph;
+    F1Value e;
+    compressive(c, ph, phi_m, a, visc, p_tr, tau_tr, u_eq, e, b.c_g[i], b.c_p[i], b.c_tau[i], b.c_xi2[i]);
+    const double fr0 = (mu0 + c.K_3 * (ph - phi_m / (1.0 + a * 0.0))) * p_tr;
+    b.f1_trial[i] = tau_tr - (fr0 < 0.0 ? 0.0 : fr0);  // E21 at gamma_dot = 0 (std::max(fr0, 0))
+    b.R_lo[i] = e.R;
+    b.dil_p[i] = p_tr + dil * g_max;
+    double x, hi, tg, tu;
+    f1_start(c, mu0, ph, phi_m, a, visc, p_tr, tau_tr, u_eq, g_max, e, x, hi);
+    tension_start(c, phi_m, a, p_tr, dil, g_max, tg, tu);
+    const double g_sep = tau_tr > 0.0 ? g_max : 0.0;
+    const double xi1 = -p_tr / c.Kdt - c.K_3 * ph * g_sep;  // E22: p = p_tr + K dt (beta g + xi_1) = 0
+    b.xi1[i] = xi1 < 0.0 ? 0.0 : xi1;
+    b.phi_m[i] = phi_m, b.a[i] = a, b.visc[i] = visc, b.lo[i] = u_eq, b.x[i] = x, b.hi[i] = hi;
+    b.g_max[i] = g_max, b.tu[i] = tu;
+  }
+  // The branch (a loop of its own: in the loop above, GCC 12 finds no vector type once these
+  // selects are in it)
+  for (int i = 0; i < m; ++i) {
+    const double ph = b.s_phi[i], p_tr = b.s_p_tr[i], tau_tr = b.s_tau_tr[i];
+    // p_tr > 0: elastic (f_1 and f_3 inactive at the trial), the f_1 + f_3 closed form, or the f_1 solve
+    const double closed_or_f1 = b.R_lo[i] <= 0.0 && b.lo[i] > 0.0 ? kClosedForm : kF1Solve;
+    const double kind_c = !(ph < b.phi_m[i]) && b.f1_trial[i] <= 0.0 ? kElasticTrial : closed_or_f1;
+    // p_tr <= 0: separated (f_2 active) unless shear dilatancy builds pressure, else the fast path
+    const double kind_t = tau_tr > 0.0 && b.dil_p[i] > 0.0 ? kTensionSolve : kSeparatedForm;
+    b.kind[i] = p_tr > 0.0 ? kind_c : kind_t;
+  }
+}
+
+/// (4) The ends of the updates (finish()) in lanes: the staggered E24 step and the radial return.
+/// e_fast = 0 where finish() itself must run: the return map failed, a result is not finite (or
+/// their sum overflows), or the point needs the implicit structure update or the forced f = 1.
+[[gnu::noinline]] void batch_finish(const BatchConsts& k, BatchBlock& b, int m) {
+  const double K_0 = k.K_0, tau_star = k.tau_star, xi_dot_eps = k.xi_dot_eps, dt = k.dt;
+  const double stiff_max = k.stiff_max, phi_forced = k.phi_forced;
+#pragma omp simd
+  for (int i = 0; i < m; ++i) {
+    const double tau = b.r_tau[i], pp = b.r_p[i], gg = b.r_g[i], tau_tr = b.s_tau_tr[i];
+    double stiff;
+    const double fn = structure_step(K_0, tau_star, xi_dot_eps, dt, b.s_f[i], b.t_fm[i], b.t_inv_eta_B[i], tau, gg, stiff);
+    const double scale_pos = tau / tau_tr;
+    const double scale = tau_tr > 0.0 ? scale_pos : 0.0;
+    double sum = fn + gg + pp;
+    for (int q = 0; q < 9; ++q) {
+      const double v = scale * b.t_s[q][i] - ((q % 4 == 0) ? pp : 0.0);
+      b.e_sig[q][i] = v;
+      sum += v;
+    }
+    b.e_f[i] = fn;
+    const bool fast = (b.r_ok[i] != 0.0) & !(stiff > stiff_max) & !(b.s_phi[i] >= phi_forced) & (sum - sum == 0.0);
+    b.e_fast[i] = fast ? 1.0 : 0.0;
+  }
+}
+
+/// The Newton solves' lanes (kLanes wide) in SoA.
+template <int N>
+struct SolveLanes {
+  double x[N], lo[N], hi[N], phi[N], phi_m[N], a[N], visc[N], p_tr[N], tau_tr[N], g_max[N];
+  double g[N], p[N], R[N], dR[N], status[N];
+  int it[N];
+  bool final_eval[N];
+  SolveLanes() {
+    for (int l = 0; l < N; ++l) {  // finite values for lanes that never get a job
+      x[l] = lo[l] = hi[l] = g_max[l] = g[l] = 1.0;
+      phi[l] = 0.5, phi_m[l] = 0.6, a[l] = 1.0, visc[l] = 1.0, p_tr[l] = 1.0, tau_tr[l] = 1.0;
+      p[l] = R[l] = dR[l] = status[l] = 0.0;
+      it[l] = 0;
+      final_eval[l] = false;
+    }
+  }
+  void load(int l, double ph, double ph_m, double aa, double vi, double pt, double tt) {
+    phi[l] = ph, phi_m[l] = ph_m, a[l] = aa, visc[l] = vi, p_tr[l] = pt, tau_tr[l] = tt;
+    it[l] = 0;
+    final_eval[l] = false;
+  }
+};
+
+/// One iteration of every lane of the f_1-only solves: R(u) and dR/du at x (return_map's loop).
+template <int N>
+[[gnu::noinline]] void f1_lanes_value(const F1Consts& c, SolveLanes<N>& s) {
+#pragma omp simd
+  for (int l = 0; l < N; ++l) {
+    F1Value e;
+    f1_value(c, s.phi[l], s.phi_m[l], s.a[l], s.visc[l], s.p_tr[l], s.tau_tr[l], s.x[l], e);
+    s.g[l] = e.g;
+    s.p[l] = e.p;
+    s.R[l] = e.R;
+    s.dR[l] = f1_slope(c, s.phi_m[l], s.a[l], s.visc[l], s.p_tr[l], s.x[l], e);
+  }
+}
+
+/// One Newton step of every lane of the p_tr <= 0 fast path (tension_step).
+template <int N>
+[[gnu::noinline]] void tension_lanes_step(const F1Consts& c, double tol, SolveLanes<N>& s) {
+#pragma omp simd
+  for (int l = 0; l < N; ++l)
+    s.status[l] = tension_step(c, s.phi[l], s.phi_m[l], s.a[l], s.visc[l], s.p_tr[l], s.tau_tr[l], s.g_max[l], tol,
+                               s.g[l], s.x[l], s.p[l], s.R[l]);
+}
+
+}  // namespace
+
 void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* f, const Eigen::Matrix3d* L,
                                 const double* phi, double dt, GranularStep* step) const {
-  // Blocks of points: (1) trial and return map up to its Newton solve, handed back as a job (the
-  // f_1-only branch: F1Job; the p_tr <= 0 fast path: TensionJob); (2) the jobs' Newton iterations
-  // in kLanes lanes, a lane taking the next job when its own is done; (3) the rest of each update.
+  // Blocks of points: (1) the trials in lanes; (2) return_map up to its Newton solves in lanes:
+  // closed forms (elastic, f_1 + f_3, separated) and the solves handed on as jobs (the f_1-only
+  // branch: F1Job; the p_tr <= 0 fast path: TensionJob); (3) the jobs' Newton iterations in kLanes
+  // lanes, a lane taking the next job when its own is done; (4) the ends of the updates in lanes.
   // Every point does the arithmetic of advance() in the same order (the same inline functions), so
-  // the results are those of advance(), bit for bit.
-  constexpr int kBlock = 128;
+  // the results are those of advance(), bit for bit; a point whose solve fails in lanes, or that
+  // needs the implicit structure update, goes through return_map()/finish() themselves.
+  constexpr int kBlock = BatchBlock::kSize;
   constexpr int N = kLanes;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
   const F1Consts c{K_ * dt, G_ * dt, 2.0 * eta_0_, d2_rho_s_, K_3_, mu_1_, mu_2_, b_};
+  BatchConsts kc{};
+  kc.c = c;
+  kc.dt = dt, kc.G = G_, kc.K = K_, kc.eta_0 = eta_0_;
+  kc.phi_j = phi_j_, kc.phi_c = phi_c_, kc.a_0 = a_0_, kc.a_inf = a_inf_, kc.mu0 = mu_q(0.0);
+  kc.K_0 = K_0_, kc.tau_star = tau_star_, kc.xi_dot_eps = xi_dot_eps_;
+  kc.stiff_max = options_.structure_update == StructureUpdate::kImplicit ? -kInf
+                 : options_.structure_update == StructureUpdate::kAuto   ? options_.stiff_structure
+                                                                         : kInf;
+  kc.phi_forced = options_.jammed_structure == JammedStructure::kForceOne ? phi_j_ : kInf;
+  kc.step_ok = step_inputs_valid(dt, eta_0_);
+  kc.steady = &steady_;
   const double tol = options_.rel_tol;
   const int cap = options_.max_iter;
+  BatchBlock b;
   for (std::int64_t b0 = 0; b0 < n; b0 += kBlock) {
     const int m = static_cast<int>(std::min<std::int64_t>(kBlock, n - b0));
     ReturnMap rm[kBlock];
@@ -915,46 +1124,9 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
     TensionJob tj[kBlock];
     int f1_point[kBlock], tj_point[kBlock];
     int n_f1 = 0, n_tj = 0;
-    // ---- (1) trials; the p_tr > 0 values at u_eq and the f_1 + f_3 closed form for every point
-    // in lanes (where unused too); then each return map up to its Newton solve ----
-    double s_f[kBlock], s_phi[kBlock], s_p_tr[kBlock], s_tau_tr[kBlock];
-    double c_g_lo[kBlock], c_p_lo[kBlock], c_R_lo[kBlock], c_be[kBlock], c_mq[kBlock], c_disc[kBlock];
-    double c_g[kBlock], c_p[kBlock], c_tau[kBlock], c_xi2[kBlock];
-    // The E16 trials (begin(): checks, trial, f_m) in lanes: sigma and L gathered component-major
-    double bS[9][kBlock], bL[9][kBlock], t_s[9][kBlock], t_fm[kBlock], t_inv_eta_B[kBlock];
-    for (int i = 0; i < m; ++i) {
-      for (int k = 0; k < 9; ++k) {
-        bS[k][i] = sigma[b0 + i].data()[k];
-        bL[k][i] = L[b0 + i].data()[k];
-      }
-    }
-    const double G = G_, K = K_;
-    double ok_lane[kBlock];
-    const bool step_ok = step_inputs_valid(dt, eta_0_);
-#pragma omp simd
-    for (int i = 0; i < m; ++i) {
-      T9 Sx, Dx, Wx;
-      double pt, tt;
-      for (int k = 0; k < 9; ++k) Sx.v[k] = bS[k][i];
-      for (int jj = 0; jj < 3; ++jj) {
-        for (int ii = 0; ii < 3; ++ii) {
-          Dx.v[ii + 3 * jj] = 0.5 * (bL[ii + 3 * jj][i] + bL[jj + 3 * ii][i]);
-          Wx.v[ii + 3 * jj] = 0.5 * (bL[ii + 3 * jj][i] - bL[jj + 3 * ii][i]);
-        }
-      }
-      T9 sx;
-      elastic_trial(Sx, Dx, Wx, dt, G, K, sx, pt, tt);
-      const double ff = f[b0 + i], ph = phi[b0 + i];
-      const bool ok = step_ok & point_inputs_valid(ph, ff, Sx, Dx, Wx);  // as begin()
-      for (int k = 0; k < 9; ++k) t_s[k][i] = sx.v[k];
-      ok_lane[i] = ok ? 1.0 : 0.0;  // (a bool store here stops the SSE2 vectorisation)
-      s_f[i] = ff;
-      s_phi[i] = ph;
-      s_p_tr[i] = ok ? pt : 1.0;
-      s_tau_tr[i] = ok ? tt : 1.0;
-      t_fm[i] = rheology::f_m(steady_, ph);
-    }
-    for (int i = 0; i < m; ++i) valid[i] = ok_lane[i] != 0.0;
+    // ---- (1) trials ----
+    batch_trials(kc, b, m, sigma + b0, L + b0, f + b0, phi + b0);
+    for (int i = 0; i < m; ++i) valid[i] = b.ok[i] != 0.0;
     // E8 on its own, in blocks with the powers in vector lanes (inside begin() they serialised
     // with the trial); lanes of invalid points (and past m) get a stand-in phi and then 0
     static_assert(kBlock % numerics::kMathBlock == 0);
@@ -962,112 +1134,91 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
       double x[numerics::kMathBlock], r[numerics::kMathBlock];
       for (int j = 0; j < numerics::kMathBlock; ++j) x[j] = i0 + j < m && valid[i0 + j] ? phi[b0 + i0 + j] : 0.5;
       inv_eta_B_block(x, r);
-      for (int j = 0; j < numerics::kMathBlock && i0 + j < m; ++j) t_inv_eta_B[i0 + j] = valid[i0 + j] ? r[j] : 0.0;
+      for (int j = 0; j < numerics::kMathBlock && i0 + j < m; ++j) b.t_inv_eta_B[i0 + j] = valid[i0 + j] ? r[j] : 0.0;
     }
-    const double phi_j = phi_j_, phi_c = phi_c_, a_0 = a_0_, a_inf = a_inf_, eta_0 = eta_0_;
-#pragma omp simd
-    for (int i = 0; i < m; ++i) {
-      // as at the top of return_map
-      const double ph = s_phi[i];
-      const double phi_m = phi_j + (phi_c - phi_j) * s_f[i];  // E1
-      const double a = a_0 + (a_inf - a_0) * s_f[i];          // E2
-      const double visc = 2.5 * ph / a * eta_0;
-      const double u_eq_below = (phi_m - ph) / (a * ph);
-      const double u_eq = ph < phi_m ? u_eq_below : 0.0;
-      F1Value e;
-      double gc, pc, tc, xc;
-      compressive(c, ph, phi_m, a, visc, s_p_tr[i], s_tau_tr[i], u_eq, e, gc, pc, tc, xc);
-      c_g_lo[i] = e.g, c_p_lo[i] = e.p, c_R_lo[i] = e.R;
-      c_be[i] = e.be, c_mq[i] = e.mq, c_disc[i] = e.disc;
-      c_g[i] = gc, c_p[i] = pc, c_tau[i] = tc, c_xi2[i] = xc;
-    }
+    // ---- (2) return_map up to its Newton solves ----
+    batch_classify(kc, b, m);
     for (int i = 0; i < m; ++i) {
       if (!valid[i]) continue;
-      const std::int64_t q = b0 + i;
-      const Compressive cm{F1Value{c_g_lo[i], c_p_lo[i], c_R_lo[i], c_be[i], c_mq[i], c_disc[i]}, c_g[i], c_p[i],
-                           c_tau[i], c_xi2[i]};
-      rm[i] = return_map(f[q], phi[q], eta_0_, dt, s_p_tr[i], s_tau_tr[i], &f1[n_f1], &tj[n_tj], &cm);
-      if (!rm[i].deferred) continue;
-      if (s_p_tr[i] > 0.0) f1_point[n_f1++] = i;
-      else tj_point[n_tj++] = i;
+      const double p_tr = b.s_p_tr[i], tau_tr = b.s_tau_tr[i];
+      ReturnMap& o = rm[i];
+      o = ReturnMap{};
+      switch (static_cast<int>(b.kind[i])) {
+        case static_cast<int>(kElasticTrial):
+          o.tau = tau_tr;
+          o.p = p_tr;
+          break;
+        case static_cast<int>(kClosedForm):  // f_1 + f_3 (E21, E23 with K_4 = 0)
+          o.g = b.c_g[i];
+          o.p = b.c_p[i];
+          o.tau = b.c_tau[i];
+          o.xi2 = b.c_xi2[i];
+          o.regime = o.g > 0.0 ? GranularRegime::kShearCompaction : GranularRegime::kCompaction;
+          break;
+        case static_cast<int>(kSeparatedForm):
+          o.regime = (tau_tr > 0.0 || p_tr < 0.0) ? GranularRegime::kSeparated : GranularRegime::kElastic;
+          o.g = tau_tr > 0.0 ? b.g_max[i] : 0.0;
+          o.xi1 = b.xi1[i];
+          break;
+        case static_cast<int>(kF1Solve):
+          f1[n_f1] = F1Job{b.s_phi[i], b.phi_m[i], b.a[i], b.visc[i], p_tr, tau_tr, b.x[i], b.lo[i], b.hi[i]};
+          f1_point[n_f1++] = i;
+          break;
+        default:
+          tj[n_tj] = TensionJob{b.s_phi[i], b.phi_m[i], b.a[i], b.visc[i], p_tr, tau_tr, b.g_max[i], b.g_max[i], b.tu[i]};
+          tj_point[n_tj++] = i;
+      }
     }
-    // ---- (2) lanes in SoA; results per job ----
+    // ---- (3) the Newton solves in lanes; results per job ----
     struct Result {
       double g, p, u, R;
-      int status;  // 1 converged, 2 failed, 3 (tension) step converged: check in (3)
+      int status;  // 1 converged, 2 failed, 3 (tension) step converged: check below
     };
     Result res_f1[kBlock], res_tj[kBlock];
-    double x[N], lo[N], hi[N], lphi[N], lphi_m[N], la[N], lvisc[N], lp_tr[N], ltau_tr[N], lg_max[N];
-    double g[N], p[N], R[N], dR[N], status[N];
-    int it[N];
-    bool final_eval[N];
-    for (int l = 0; l < N; ++l) {  // finite values for lanes that never get a job
-      x[l] = lo[l] = hi[l] = lg_max[l] = g[l] = 1.0;
-      lphi[l] = 0.5, lphi_m[l] = 0.6, la[l] = 1.0, lvisc[l] = 1.0, lp_tr[l] = 1.0, ltau_tr[l] = 1.0;
-    }
-    auto load_common = [&](int l, double ph, double ph_m, double aa, double vi, double pt, double tt) {
-      lphi[l] = ph, lphi_m[l] = ph_m, la[l] = aa, lvisc[l] = vi, lp_tr[l] = pt, ltau_tr[l] = tt;
-      it[l] = 0;
-      final_eval[l] = false;
-    };
-    // (2a) f_1-only branch: Newton in u with bracket [lo, hi] (return_map's scalar loop, same steps)
+    SolveLanes<N> s;
+    // (3a) f_1-only branch: Newton in u with bracket [lo, hi] (return_map's scalar loop, same steps)
     run_lanes<N>(
         n_f1,
         [&](int l, int j) {
           const F1Job& jb = f1[j];
-          load_common(l, jb.phi, jb.phi_m, jb.a, jb.visc, jb.p_tr, jb.tau_tr);
-          x[l] = jb.x, lo[l] = jb.lo, hi[l] = jb.hi;
+          s.load(l, jb.phi, jb.phi_m, jb.a, jb.visc, jb.p_tr, jb.tau_tr);
+          s.x[l] = jb.x, s.lo[l] = jb.lo, s.hi[l] = jb.hi;
         },
-        [&] {
-#pragma omp simd
-          for (int l = 0; l < N; ++l) {
-            F1Value e;
-            f1_value(c, lphi[l], lphi_m[l], la[l], lvisc[l], lp_tr[l], ltau_tr[l], x[l], e);
-            g[l] = e.g;
-            p[l] = e.p;
-            R[l] = e.R;
-            dR[l] = f1_slope(c, lphi_m[l], la[l], lvisc[l], lp_tr[l], x[l], e);
-          }
-        },
+        [&] { f1_lanes_value<N>(c, s); },
         [&](int l, int j) {
-          if (!final_eval[l]) {  // (st == 1: converged at the evaluated x, which f1_step leaves as it was)
-            const int st = f1_step(R[l], dR[l], ltau_tr[l], tol, x[l], lo[l], hi[l]);
-            ++it[l];
+          if (!s.final_eval[l]) {  // (st == 1: converged at the evaluated x, which f1_step leaves as it was)
+            const int st = f1_step(s.R[l], s.dR[l], s.tau_tr[l], tol, s.x[l], s.lo[l], s.hi[l]);
+            ++s.it[l];
             if (st == 2) {
-              final_eval[l] = true;  // evaluate at the new x, then stop
+              s.final_eval[l] = true;  // evaluate at the new x, then stop
               return false;
             }
-            if (st == 0 && it[l] < cap) return false;
+            if (st == 0 && s.it[l] < cap) return false;
             if (st == 0) {  // iteration cap
               res_f1[j] = Result{0.0, 0.0, 0.0, 0.0, 2};
               return true;
             }
           }
-          res_f1[j] = Result{g[l], p[l], x[l], R[l], 1};
+          res_f1[j] = Result{s.g[l], s.p[l], s.x[l], s.R[l], 1};
           return true;
         });
-    // (2b) p_tr <= 0 fast path: Newton on (gamma_dot, u), at most kTensionIterations steps
+    // (3b) p_tr <= 0 fast path: Newton on (gamma_dot, u), at most kTensionIterations steps
     run_lanes<N>(
         n_tj,
         [&](int l, int j) {
           const TensionJob& jb = tj[j];
-          load_common(l, jb.phi, jb.phi_m, jb.a, jb.visc, jb.p_tr, jb.tau_tr);
-          lg_max[l] = jb.g_max, g[l] = jb.g, x[l] = jb.u;
+          s.load(l, jb.phi, jb.phi_m, jb.a, jb.visc, jb.p_tr, jb.tau_tr);
+          s.g_max[l] = jb.g_max, s.g[l] = jb.g, s.x[l] = jb.u;
         },
-        [&] {
-#pragma omp simd
-          for (int l = 0; l < N; ++l)
-            status[l] = tension_step(c, lphi[l], lphi_m[l], la[l], lvisc[l], lp_tr[l], ltau_tr[l], lg_max[l], tol, g[l],
-                                     x[l], p[l], R[l]);
-        },
+        [&] { tension_lanes_step<N>(c, tol, s); },
         [&](int l, int j) {
-          ++it[l];
-          const int st = static_cast<int>(status[l]);
-          if (st == 0 && it[l] < kTensionIterations) return false;
-          res_tj[j] = Result{g[l], p[l], x[l], R[l], st == 0 ? 2 : st};
+          ++s.it[l];
+          const int st = static_cast<int>(s.status[l]);
+          if (st == 0 && s.it[l] < kTensionIterations) return false;
+          res_tj[j] = Result{s.g[l], s.p[l], s.x[l], s.R[l], st == 0 ? 2 : st};
           return true;
         });
-    // ---- (3) the deferred return maps' ends (the scalar path for a job that failed) ----
+    // the solved return maps' ends (the scalar path for a job that failed)
     for (int k = 0; k < n_f1; ++k) {
       const int i = f1_point[k];
       const std::int64_t q = b0 + i;
@@ -1109,21 +1260,33 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
       o.regime = pp > 0.0 ? GranularRegime::kShear : GranularRegime::kSeparated;
       if (pp <= 0.0) o.xi1 = std::max(-jb.p_tr / c.Kdt - K_3_ * jb.phi * gg, 0.0);
     }
+    // ---- (4) the ends of the updates in lanes; finish() itself where they cannot be ----
+    for (int i = 0; i < m; ++i) {
+      b.r_tau[i] = rm[i].tau, b.r_p[i] = rm[i].p, b.r_g[i] = rm[i].g;
+      b.r_ok[i] = valid[i] && rm[i].converged ? 1.0 : 0.0;
+    }
+    batch_finish(kc, b, m);
     for (int i = 0; i < m; ++i) {
       const std::int64_t q = b0 + i;
       if (!valid[i]) {
         step[q] = GranularStep{GranularRegime::kElastic, false, 0.0};
         continue;
       }
+      if (b.e_fast[i] != 0.0) {
+        step[q] = GranularStep{rm[i].regime, true, rm[i].g};
+        for (int k = 0; k < 9; ++k) sigma[q].data()[k] = b.e_sig[k][i];
+        f[q] = b.e_f[i];
+        continue;
+      }
       GranularState st;
       for (int k = 0; k < 9; ++k) st.sigma.data()[k] = sigma[q].data()[k];
       st.f = f[q];
       Trial t;
-      for (int k = 0; k < 9; ++k) t.s.data()[k] = t_s[k][i];
-      t.p_tr = s_p_tr[i];
-      t.tau_tr = s_tau_tr[i];
-      t.fm = t_fm[i];
-      t.inv_eta_B = t_inv_eta_B[i];
+      for (int k = 0; k < 9; ++k) t.s.data()[k] = b.t_s[k][i];
+      t.p_tr = b.s_p_tr[i];
+      t.tau_tr = b.s_tau_tr[i];
+      t.fm = b.t_fm[i];
+      t.inv_eta_B = b.t_inv_eta_B[i];
       GranularUpdate out;
       finish<false>(st, t, rm[i], dt, phi[q], eta_0_, out);
       step[q] = GranularStep{out.regime, out.ok(), out.gamma_dot_p};

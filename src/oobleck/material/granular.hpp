@@ -98,10 +98,6 @@ struct GranularOptions {
   double stiff_structure = 0.5;  ///< kAuto threshold on dt (H' + S') [-] (staggering oscillates when >~ 1)
 };
 
-namespace granular_detail {
-struct Compressive;  ///< return_map's p_tr > 0 values computed ahead for a block of points (granular.cpp)
-}
-
 /// The law with its constants precomputed. Cheap to copy; thread-safe (update() is const).
 class GranularLaw {
  public:
@@ -159,7 +155,6 @@ class GranularLaw {
     double tau = 0.0, p = 0.0, g = 0.0, xi1 = 0.0, xi2 = 0.0, residual = 0.0;
     GranularRegime regime = GranularRegime::kElastic;
     bool converged = true;
-    bool deferred = false;  ///< the Newton solve was handed to the caller (F1Job or TensionJob)
     int iterations = 0;
   };
   /// The E16 trial of a point and the E24 ingredients that depend on phi only.
@@ -195,12 +190,10 @@ class GranularLaw {
   template <bool kDiagnostics>
   void finish(GranularState& state, const Trial& t, ReturnMap r, double dt, double phi, double eta_0,
               GranularUpdate& out) const;
-  /// E17–E23 at structure f for a given trial (p_tr, tau_tr): allocation-free, never throws. With
-  /// `defer` (`defer2`), the f_1-only branch (the p_tr <= 0 fast path) returns deferred = true and
-  /// its Newton solve in *defer (*defer2).
-  ReturnMap return_map(double f, double phi, double eta_0, double dt, double p_tr, double tau_tr,
-                       F1Job* defer = nullptr, TensionJob* defer2 = nullptr,
-                       const granular_detail::Compressive* pre = nullptr) const;
+  /// E17–E23 at structure f for a given trial (p_tr, tau_tr): allocation-free, never throws.
+  /// (advance_batch takes its branches, closed forms and Newton starts in lanes with the same inline
+  /// functions, runs the Newton solves as F1Job/TensionJob in lanes, and calls it where those fail.)
+  ReturnMap return_map(double f, double phi, double eta_0, double dt, double p_tr, double tau_tr) const;
 
   rheology::SteadyParams steady_;
   rheology::GranularParams granular_;
