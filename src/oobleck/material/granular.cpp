@@ -928,7 +928,7 @@ struct BatchBlock {
   // return_map's branch (kind), the f_1 + f_3 closed form, the solves' constants and starts
   double kind[kSize], c_g[kSize], c_p[kSize], c_tau[kSize], c_xi2[kSize];
   double phi_m[kSize], a[kSize], visc[kSize], lo[kSize], x[kSize], hi[kSize], g_max[kSize], tu[kSize], xi1[kSize];
-  double f1_trial[kSize], R_lo[kSize], dil_p[kSize];  // what decides the branch
+  double f1_trial[kSize], dil_p[kSize], e_lo[6][kSize];  // what decides the branch; e_lo: F1Value at u_eq
   // the return maps' results, and the ends of the updates
   double r_tau[kSize], r_p[kSize], r_g[kSize], r_ok[kSize], e_f[kSize], e_fast[kSize], e_sig[9][kSize];
 };
@@ -992,27 +992,37 @@ struct BatchBlock {
     compressive(c, ph, phi_m, a, visc, p_tr, tau_tr, u_eq, e, b.c_g[i], b.c_p[i], b.c_tau[i], b.c_xi2[i]);
     const double fr0 = (mu0 + c.K_3 * (ph - phi_m / (1.0 + a * 0.0))) * p_tr;
     b.f1_trial[i] = tau_tr - (fr0 < 0.0 ? 0.0 : fr0);  // E21 at gamma_dot = 0 (std::max(fr0, 0))
-    b.R_lo[i] = e.R;
     b.dil_p[i] = p_tr + dil * g_max;
-    double x, hi, tg, tu;
-    f1_start(c, mu0, ph, phi_m, a, visc, p_tr, tau_tr, u_eq, g_max, e, x, hi);
+    b.e_lo[0][i] = e.g, b.e_lo[1][i] = e.p, b.e_lo[2][i] = e.R, b.e_lo[3][i] = e.be, b.e_lo[4][i] = e.mq;
+    b.e_lo[5][i] = e.disc;
+    double tg, tu;
     tension_start(c, phi_m, a, p_tr, dil, g_max, tg, tu);
     const double g_sep = tau_tr > 0.0 ? g_max : 0.0;
     const double xi1 = -p_tr / c.Kdt - c.K_3 * ph * g_sep;  // E22: p = p_tr + K dt (beta g + xi_1) = 0
     b.xi1[i] = xi1 < 0.0 ? 0.0 : xi1;
-    b.phi_m[i] = phi_m, b.a[i] = a, b.visc[i] = visc, b.lo[i] = u_eq, b.x[i] = x, b.hi[i] = hi;
+    b.phi_m[i] = phi_m, b.a[i] = a, b.visc[i] = visc, b.lo[i] = u_eq;
     b.g_max[i] = g_max, b.tu[i] = tu;
   }
   // The branch (a loop of its own: in the loop above, GCC 12 finds no vector type once these
   // selects are in it)
+  int f1_solves = 0;
   for (int i = 0; i < m; ++i) {
     const double ph = b.s_phi[i], p_tr = b.s_p_tr[i], tau_tr = b.s_tau_tr[i];
     // p_tr > 0: elastic (f_1 and f_3 inactive at the trial), the f_1 + f_3 closed form, or the f_1 solve
-    const double closed_or_f1 = b.R_lo[i] <= 0.0 && b.lo[i] > 0.0 ? kClosedForm : kF1Solve;
+    const double closed_or_f1 = b.e_lo[2][i] <= 0.0 && b.lo[i] > 0.0 ? kClosedForm : kF1Solve;
     const double kind_c = !(ph < b.phi_m[i]) && b.f1_trial[i] <= 0.0 ? kElasticTrial : closed_or_f1;
     // p_tr <= 0: separated (f_2 active) unless shear dilatancy builds pressure, else the fast path
     const double kind_t = tau_tr > 0.0 && b.dil_p[i] > 0.0 ? kTensionSolve : kSeparatedForm;
     b.kind[i] = p_tr > 0.0 ? kind_c : kind_t;
+    f1_solves += b.kind[i] == kF1Solve ? 1 : 0;
+  }
+  // The f_1 solves' starts (a quarter of the loop above), only in blocks that have such a solve
+  if (f1_solves == 0) return;
+#pragma omp simd
+  for (int i = 0; i < m; ++i) {
+    const F1Value e{b.e_lo[0][i], b.e_lo[1][i], b.e_lo[2][i], b.e_lo[3][i], b.e_lo[4][i], b.e_lo[5][i]};
+    f1_start(c, mu0, b.s_phi[i], b.phi_m[i], b.a[i], b.visc[i], b.s_p_tr[i], b.s_tau_tr[i], b.lo[i], b.g_max[i], e,
+             b.x[i], b.hi[i]);
   }
 }
 
