@@ -176,9 +176,12 @@ namespace {
 // results of advance() point by point, bit for bit, in every regime and on failures: random
 // states as in the sweep above (one dt per batch), a loose bed as in the bench set-ups, and a few
 // invalid inputs (non-finite L, phi outside (0, 1)).
-void batch_equals_point_by_point(const std::string& preset_name, std::uint64_t seed, double dt, bool loose) {
+// `options` other than the defaults: exactly the three invalid inputs fail only with the defaults
+// (a small max_iter makes some return maps stop unconverged, `not_ok` then counts those too).
+void batch_equals_point_by_point(const std::string& preset_name, std::uint64_t seed, double dt, bool loose,
+                                 material::GranularOptions options = {}) {
   const rheology::Preset P = test::preset(preset_name);
-  const material::GranularLaw law(P);
+  const material::GranularLaw law(P, options);
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> U(0.0, 1.0);
   const int n = 3000;
@@ -199,6 +202,18 @@ void batch_equals_point_by_point(const std::string& preset_name, std::uint64_t s
   L[7](0, 1) = std::numeric_limits<double>::quiet_NaN();  // invalid inputs: reported, state kept
   phi[11] = 1.0;
   phi[2999] = 0.0;
+  // edge points: a stress-free point at rest (p_tr = -0, tau_tr = 0: the separated form, regime
+  // elastic), isotropic compression at rest above phi_j (elastic trial with tau_tr = 0), phi on
+  // phi_m(f) exactly (u_eq = 0), and stresses near the largest double (the trial overflows: the
+  // scalar end of step)
+  sigma[20].setZero();
+  L[20].setZero();
+  sigma[21] = -1e3 * Eigen::Matrix3d::Identity();
+  L[21].setZero();
+  phi[21] = 0.6;
+  f[22] = 0.0;
+  phi[22] = P.steady.phi_j;
+  sigma[23] *= 1e307 / sigma[23].cwiseAbs().maxCoeff();
   std::vector<Eigen::Matrix3d> sigma_b = sigma, sigma_p = sigma;
   std::vector<double> f_b = f, f_p = f;
   std::vector<material::GranularStep> step_b(n), step_p(n);
@@ -227,7 +242,12 @@ void batch_equals_point_by_point(const std::string& preset_name, std::uint64_t s
       ADD_FAILURE() << "point " << k << ": batch and point-by-point results differ (phi = " << phi[k] << ")";
   }
   EXPECT_EQ(mismatches, 0);
-  EXPECT_EQ(not_ok, 3);  // exactly the three invalid inputs
+  const bool defaults = options.max_iter == material::GranularOptions{}.max_iter;
+  if (defaults) {
+    EXPECT_EQ(not_ok, 3 + (step_p[23].ok ? 0 : 1));  // the three invalid inputs (and the overflow)
+  } else {
+    EXPECT_GT(not_ok, 3);  // the cap stopped some return maps
+  }
   // the batch must have met the regimes whose Newton solves it runs in lanes
   EXPECT_GT(counts[static_cast<int>(GranularRegime::kShear)], n / 20);
   EXPECT_GT(counts[static_cast<int>(GranularRegime::kShearCompaction)] + counts[static_cast<int>(GranularRegime::kCompaction)],
@@ -242,6 +262,22 @@ void batch_equals_point_by_point(const std::string& preset_name, std::uint64_t s
 TEST(GranularRobustness, BatchEqualsPointByPointRandomStates) {
   batch_equals_point_by_point("hermes2016", 99, 1e-5, false);
   batch_equals_point_by_point("dhaene1993", 98, 1e-3, false);
+}
+// The structure-update and jammed-structure options, whose points take finish() itself in
+// advance_batch (implicit update, forced f = 1), and unconverged return maps (iteration cap).
+TEST(GranularRobustness, BatchEqualsPointByPointOptions) {
+  material::GranularOptions implicit;
+  implicit.structure_update = material::StructureUpdate::kImplicit;
+  batch_equals_point_by_point("hermes2016", 95, 1e-5, false, implicit);
+  material::GranularOptions staggered;
+  staggered.structure_update = material::StructureUpdate::kStaggered;
+  batch_equals_point_by_point("hermes2016", 94, 1e-5, false, staggered);
+  material::GranularOptions forced;
+  forced.jammed_structure = material::JammedStructure::kForceOne;
+  batch_equals_point_by_point("hermes2016", 93, 1e-5, false, forced);
+  material::GranularOptions capped;
+  capped.max_iter = 5;
+  batch_equals_point_by_point("hermes2016", 92, 1e-5, false, capped);
 }
 TEST(GranularRobustness, BatchEqualsPointByPointLooseBed) {
   batch_equals_point_by_point("hermes2016", 97, 2e-5, true);

@@ -914,8 +914,9 @@ struct BatchConsts {
   F1Consts c;
   double dt, G, K, eta_0, phi_j, phi_c, a_0, a_inf, mu0;
   double K_0, tau_star, xi_dot_eps;
-  double stiff_max;   ///< finish() takes the implicit structure update above this dt (H' + S')
-  double phi_forced;  ///< finish() forces f = 1 from this phi on (kForceOne), else infinity
+  double stiff_max;     ///< finish() takes the implicit structure update above this dt (H' + S') (kAuto)
+  double phi_forced;    ///< finish() forces f = 1 from this phi on (kForceOne), else infinity
+  bool implicit_always;  ///< kImplicit: every point goes through finish()
   bool step_ok;       ///< step_inputs_valid(dt, eta_0)
   const rheology::SteadyParams* steady;
 };
@@ -1031,22 +1032,24 @@ struct BatchBlock {
 /// their sum overflows), or the point needs the implicit structure update or the forced f = 1.
 [[gnu::noinline]] void batch_finish(const BatchConsts& k, BatchBlock& b, int m) {
   const double K_0 = k.K_0, tau_star = k.tau_star, xi_dot_eps = k.xi_dot_eps, dt = k.dt;
-  const double stiff_max = k.stiff_max, phi_forced = k.phi_forced;
+  const double stiff_max = k.stiff_max, phi_forced = k.phi_forced, lanes_ok = k.implicit_always ? 0.0 : 1.0;
 #pragma omp simd
   for (int i = 0; i < m; ++i) {
     const double tau = b.r_tau[i], pp = b.r_p[i], gg = b.r_g[i], tau_tr = b.s_tau_tr[i];
     double stiff;
-    const double fn = structure_step(K_0, tau_star, xi_dot_eps, dt, b.s_f[i], b.t_fm[i], b.t_inv_eta_B[i], tau, gg, stiff);
+    const double f_new = structure_step(K_0, tau_star, xi_dot_eps, dt, b.s_f[i], b.t_fm[i], b.t_inv_eta_B[i], tau, gg,
+                                        stiff);
     const double scale_pos = tau / tau_tr;
     const double scale = tau_tr > 0.0 ? scale_pos : 0.0;
-    double sum = fn + gg + pp;
+    double sum = f_new + gg + pp;
     for (int q = 0; q < 9; ++q) {
       const double v = scale * b.t_s[q][i] - ((q % 4 == 0) ? pp : 0.0);
       b.e_sig[q][i] = v;
       sum += v;
     }
-    b.e_f[i] = fn;
-    const bool fast = (b.r_ok[i] != 0.0) & !(stiff > stiff_max) & !(b.s_phi[i] >= phi_forced) & (sum - sum == 0.0);
+    b.e_f[i] = f_new;
+    const bool fast = (b.r_ok[i] * lanes_ok != 0.0) & !(stiff > stiff_max) & !(b.s_phi[i] >= phi_forced) &
+                      (sum - sum == 0.0);
     b.e_fast[i] = fast ? 1.0 : 0.0;
   }
 }
@@ -1117,9 +1120,8 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
   kc.dt = dt, kc.G = G_, kc.K = K_, kc.eta_0 = eta_0_;
   kc.phi_j = phi_j_, kc.phi_c = phi_c_, kc.a_0 = a_0_, kc.a_inf = a_inf_, kc.mu0 = mu_q(0.0);
   kc.K_0 = K_0_, kc.tau_star = tau_star_, kc.xi_dot_eps = xi_dot_eps_;
-  kc.stiff_max = options_.structure_update == StructureUpdate::kImplicit ? -kInf
-                 : options_.structure_update == StructureUpdate::kAuto   ? options_.stiff_structure
-                                                                         : kInf;
+  kc.stiff_max = options_.structure_update == StructureUpdate::kAuto ? options_.stiff_structure : kInf;
+  kc.implicit_always = options_.structure_update == StructureUpdate::kImplicit;
   kc.phi_forced = options_.jammed_structure == JammedStructure::kForceOne ? phi_j_ : kInf;
   kc.step_ok = step_inputs_valid(dt, eta_0_);
   kc.steady = &steady_;

@@ -120,12 +120,16 @@ class GranularLaw {
   GranularStep advance(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W, double dt,
                        double phi) const;
 
-  /// advance() for n points at once (the MPM adapter's loop), with the same results bit for bit:
-  /// point i has stress sigma[i] and structure f[i], updated in place only when step[i].ok, velocity
-  /// gradient L[i] [1/s] (D and W are its symmetric and skew parts) and volume fraction phi[i].
-  /// The Newton solves (the f_1-only branch, the p_tr <= 0 fast path) run side by side in kLanes
-  /// lanes, vectorised across points, and so does the f_1 + f_3 closed form, instead of one
-  /// latency-bound chain per point (docs/granular.md). n may be any size (blocks of 128 inside).
+  /// advance() for n points at once (the MPM adapter's loop), with the same results bit for bit
+  /// for every point whose step[i].ok (the same step[i] for all points): point i has stress
+  /// sigma[i] and structure f[i], updated in place only when step[i].ok (advance() also stores a
+  /// finite unconverged iterate), velocity gradient L[i] [1/s] (D and W are its symmetric and skew
+  /// parts) and volume fraction phi[i]. Blocks of 128 points run in vector lanes phase by phase:
+  /// the trials, the return map's branch, closed forms and Newton starts, the Newton solves (the
+  /// f_1-only branch, the p_tr <= 0 fast path; kLanes lanes, a lane taking the next job when its
+  /// own is done) and the end of step; return_map() and finish() themselves only where a lane
+  /// solve fails or a point needs the implicit structure update or the forced f = 1
+  /// (docs/granular.md). n may be any size.
   void advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* f, const Eigen::Matrix3d* L, const double* phi,
                      double dt, GranularStep* step) const;
   static constexpr int kLanes = 8;
