@@ -163,7 +163,6 @@ struct Compressive {
   double g, p, tau, xi2;
 };
 
-
 /// E20 mu_q(I_m) = mu_1 + (mu_2 - mu_1) I_m/(I_m + b) (GranularLaw::mu_q, mu_2 for b = 0) and its
 /// derivative, without branches (both sides computed) so that the lane loops vectorise.
 inline double f1_mu_q(const F1Consts& c, double uu) {
@@ -252,7 +251,6 @@ inline void compressive(const F1Consts& c, double phi, double phi_m, double a, d
   xi2 = std::min((p - p_tr) / c.Kdt, 0.0);  // E23: xi_dot_2 <= 0
 }
 
-
 /// Start of the f_1-only Newton solve in u (return_map): the bracket's upper end hi and the first
 /// iterate x in (u_eq, hi). Upper end: with beta >= 0, gamma_dot(u) >= the beta = 0 root, so
 /// gamma_dot(u_hi) >= gamma_max = tau_tr/(G dt) when Q(gamma_max)/u_hi^2 <= p_tr; there
@@ -283,19 +281,17 @@ inline void f1_start(const F1Consts& c, double mu0, double phi, double phi_m, do
   x = ((e_lo_dR < 0.0) & (xn > lo) & (xn < x_in)) ? xn : x_in;
 }
 
-/// Start of the p_tr <= 0 fast path's Newton solve on (gamma_dot, u) (return_map): gamma_dot_max and
+/// Start of the p_tr <= 0 fast path's Newton solve on (gamma_dot, u) (return_map), at gamma_dot_max:
 /// the inner start of the nested solve's pressure balance there (h >= 0): u at the largest possible
 /// p = p_tr + K dt K_3 phi gamma_dot and, for p_tr < 0, the u at which p -> 0+.
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void tension_start(const F1Consts& c, double phi_m, double a, double p_tr, double dil, double g_max,
-                          double& gg, double& uu) {
-  gg = g_max;
-  const double S = p_tr + dil * gg, ck = c.Kdt * gg;
-  const double u_q = std::sqrt((gg * (gg * c.d2_rho_s + c.two_eta)) / S);
+inline double tension_start(const F1Consts& c, double phi_m, double a, double p_tr, double dil, double g_max) {
+  const double S = p_tr + dil * g_max, ck = c.Kdt * g_max;
+  const double u_q = std::sqrt((g_max * (g_max * c.d2_rho_s + c.two_eta)) / S);
   const double u_0 = (phi_m * ck * c.K_3 / S - 1.0) / a;
-  uu = p_tr < 0.0 && u_q < u_0 ? u_0 : u_q;  // std::max(u_q, u_0) for p_tr < 0
+  return p_tr < 0.0 && u_q < u_0 ? u_0 : u_q;  // std::max(u_q, u_0) for p_tr < 0
 }
 
 /// E24 linearly implicit with the end-of-step tau_bar, gamma_dot^p: f = (f_n + dt H' f_m)/(1 + dt (H' + S')),
@@ -589,8 +585,7 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
       // otherwise (far from the root, ill-conditioned) the bracketed nested solve in gamma_dot.
       bool fast = false;
       {
-        double gg, uu;
-        tension_start(c, phi_m, a, p_tr, dil, g_max, gg, uu);
+        double gg = g_max, uu = tension_start(c, phi_m, a, p_tr, dil, g_max);
         bool step_ok = false;
         for (int k = 1; k <= kTensionIterations; ++k) {
           ++iterations;
@@ -914,10 +909,10 @@ struct BatchConsts {
   F1Consts c;
   double dt, G, K, eta_0, phi_j, phi_c, a_0, a_inf, mu0;
   double K_0, tau_star, xi_dot_eps;
-  double stiff_max;     ///< finish() takes the implicit structure update above this dt (H' + S') (kAuto)
-  double phi_forced;    ///< finish() forces f = 1 from this phi on (kForceOne), else infinity
+  double stiff_max;      ///< finish() takes the implicit structure update above this dt (H' + S') (kAuto)
+  double phi_forced;     ///< finish() forces f = 1 from this phi on (kForceOne), else infinity
   bool implicit_always;  ///< kImplicit: every point goes through finish()
-  bool step_ok;       ///< step_inputs_valid(dt, eta_0)
+  bool step_ok;          ///< step_inputs_valid(dt, eta_0)
   const rheology::SteadyParams* steady;
 };
 
@@ -996,8 +991,7 @@ struct BatchBlock {
     b.dil_p[i] = p_tr + dil * g_max;
     b.e_lo[0][i] = e.g, b.e_lo[1][i] = e.p, b.e_lo[2][i] = e.R, b.e_lo[3][i] = e.be, b.e_lo[4][i] = e.mq;
     b.e_lo[5][i] = e.disc;
-    double tg, tu;
-    tension_start(c, phi_m, a, p_tr, dil, g_max, tg, tu);
+    const double tu = tension_start(c, phi_m, a, p_tr, dil, g_max);
     const double g_sep = tau_tr > 0.0 ? g_max : 0.0;
     const double xi1 = -p_tr / c.Kdt - c.K_3 * ph * g_sep;  // E22: p = p_tr + K dt (beta g + xi_1) = 0
     b.xi1[i] = xi1 < 0.0 ? 0.0 : xi1;
