@@ -927,6 +927,8 @@ struct BatchBlock {
   double f1_trial[kSize], dil_p[kSize], e_lo[6][kSize];  // what decides the branch; e_lo: F1Value at u_eq
   // the return maps' results, and the ends of the updates
   double r_tau[kSize], r_p[kSize], r_g[kSize], r_ok[kSize], e_f[kSize], e_fast[kSize], e_sig[9][kSize];
+  // the rest of a point's ReturnMap (regime as a double, iterations of a scalar return_map)
+  double r_xi1[kSize], r_xi2[kSize], r_res[kSize], r_reg[kSize], r_it[kSize];
 };
 
 // The lane loops below are functions of their own: inside the (large) advance_batch, GCC 12 left
@@ -1021,6 +1023,32 @@ struct BatchBlock {
   }
 }
 
+/// (2b) The results of return_map's closed-form branches (elastic trial, f_1 + f_3, separated) in
+/// every lane, as return_map writes them (the lanes of the Newton solves are overwritten after
+/// their solves; r_ok: the point's inputs are valid, and a closed form has converged).
+[[gnu::noinline]] void batch_closed(BatchBlock& b, int m) {
+  constexpr double kEl = static_cast<double>(GranularRegime::kElastic);
+  constexpr double kSep = static_cast<double>(GranularRegime::kSeparated);
+  constexpr double kSC = static_cast<double>(GranularRegime::kShearCompaction);
+  constexpr double kC = static_cast<double>(GranularRegime::kCompaction);
+  for (int i = 0; i < m; ++i) {
+    const double k = b.kind[i], p_tr = b.s_p_tr[i], tau_tr = b.s_tau_tr[i];
+    const bool el = k == kElasticTrial, cf = k == kClosedForm, sep = k == kSeparatedForm;
+    b.r_tau[i] = el ? tau_tr : (cf ? b.c_tau[i] : 0.0);
+    b.r_p[i] = el ? p_tr : (cf ? b.c_p[i] : 0.0);
+    const double g_sep = tau_tr > 0.0 ? b.g_max[i] : 0.0;
+    b.r_g[i] = cf ? b.c_g[i] : (sep ? g_sep : 0.0);
+    b.r_xi1[i] = sep ? b.xi1[i] : 0.0;
+    b.r_xi2[i] = cf ? b.c_xi2[i] : 0.0;
+    const double reg_cf = b.c_g[i] > 0.0 ? kSC : kC;
+    const double reg_sep = (tau_tr > 0.0 || p_tr < 0.0) ? kSep : kEl;
+    b.r_reg[i] = cf ? reg_cf : (sep ? reg_sep : kEl);
+    b.r_res[i] = 0.0;
+    b.r_it[i] = 0.0;
+    b.r_ok[i] = b.ok[i];
+  }
+}
+
 /// (4) The ends of the updates (finish()) in lanes: the staggered E24 step and the radial return.
 /// e_fast = 0 where finish() itself must run: the return map failed, a result is not finite (or
 /// their sum overflows), or the point needs the implicit structure update or the forced f = 1.
@@ -1099,9 +1127,10 @@ template <int N>
 void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* f, const Eigen::Matrix3d* L,
                                 const double* phi, double dt, GranularStep* step) const {
   // Blocks of points: (1) the trials in lanes; (2) return_map up to its Newton solves in lanes:
-  // closed forms (elastic, f_1 + f_3, separated) and the solves handed on as jobs (the f_1-only
-  // branch: F1Job; the p_tr <= 0 fast path: TensionJob); (3) the jobs' Newton iterations in kLanes
-  // lanes, a lane taking the next job when its own is done; (4) the ends of the updates in lanes.
+  // the branches, the closed forms' results (elastic, f_1 + f_3, separated) in the block's r_*
+  // arrays, and the solves as lists of points (the f_1-only branch; the p_tr <= 0 fast path);
+  // (3) their Newton iterations in kLanes lanes, a lane taking the next point when its own is
+  // done, the results into r_*; (4) the ends of the updates in lanes.
   // Every point does the arithmetic of advance() in the same order (the same inline functions), so
   // the results are those of advance(), bit for bit; a point whose solve fails in lanes, or that
   // needs the implicit structure update, goes through return_map()/finish() themselves.
@@ -1124,71 +1153,50 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
   BatchBlock b;
   for (std::int64_t b0 = 0; b0 < n; b0 += kBlock) {
     const int m = static_cast<int>(std::min<std::int64_t>(kBlock, n - b0));
-    ReturnMap rm[kBlock];
-    bool valid[kBlock];
-    F1Job f1[kBlock];
-    TensionJob tj[kBlock];
     int f1_point[kBlock], tj_point[kBlock];
-    int n_f1 = 0, n_tj = 0;
     // ---- (1) trials ----
     batch_trials(kc, b, m, sigma + b0, L + b0, f + b0, phi + b0);
-    for (int i = 0; i < m; ++i) valid[i] = b.ok[i] != 0.0;
     // E8 on its own, in blocks with the powers in vector lanes (inside begin() they serialised
     // with the trial); lanes of invalid points (and past m) get a stand-in phi and then 0
     static_assert(kBlock % numerics::kMathBlock == 0);
     for (int i0 = 0; i0 < m; i0 += numerics::kMathBlock) {
       double x[numerics::kMathBlock], r[numerics::kMathBlock];
-      for (int j = 0; j < numerics::kMathBlock; ++j) x[j] = i0 + j < m && valid[i0 + j] ? phi[b0 + i0 + j] : 0.5;
+      for (int j = 0; j < numerics::kMathBlock; ++j) x[j] = i0 + j < m && b.ok[i0 + j] != 0.0 ? phi[b0 + i0 + j] : 0.5;
       inv_eta_B_block(x, r);
-      for (int j = 0; j < numerics::kMathBlock && i0 + j < m; ++j) b.t_inv_eta_B[i0 + j] = valid[i0 + j] ? r[j] : 0.0;
+      for (int j = 0; j < numerics::kMathBlock && i0 + j < m; ++j) b.t_inv_eta_B[i0 + j] = b.ok[i0 + j] != 0.0 ? r[j] : 0.0;
     }
-    // ---- (2) return_map up to its Newton solves ----
+    // ---- (2) return_map up to its Newton solves: the branches, the closed forms' results, the
+    // solves as lists of points ----
     batch_classify(kc, b, m);
-    for (int i = 0; i < m; ++i) {
-      if (!valid[i]) continue;
-      const double p_tr = b.s_p_tr[i], tau_tr = b.s_tau_tr[i];
-      ReturnMap& o = rm[i];
-      o = ReturnMap{};
-      switch (static_cast<int>(b.kind[i])) {
-        case static_cast<int>(kElasticTrial):
-          o.tau = tau_tr;
-          o.p = p_tr;
-          break;
-        case static_cast<int>(kClosedForm):  // f_1 + f_3 (E21, E23 with K_4 = 0)
-          o.g = b.c_g[i];
-          o.p = b.c_p[i];
-          o.tau = b.c_tau[i];
-          o.xi2 = b.c_xi2[i];
-          o.regime = o.g > 0.0 ? GranularRegime::kShearCompaction : GranularRegime::kCompaction;
-          break;
-        case static_cast<int>(kSeparatedForm):
-          o.regime = (tau_tr > 0.0 || p_tr < 0.0) ? GranularRegime::kSeparated : GranularRegime::kElastic;
-          o.g = tau_tr > 0.0 ? b.g_max[i] : 0.0;
-          o.xi1 = b.xi1[i];
-          break;
-        case static_cast<int>(kF1Solve):
-          f1[n_f1] = F1Job{b.s_phi[i], b.phi_m[i], b.a[i], b.visc[i], p_tr, tau_tr, b.x[i], b.lo[i], b.hi[i]};
-          f1_point[n_f1++] = i;
-          break;
-        default:
-          tj[n_tj] = TensionJob{b.s_phi[i], b.phi_m[i], b.a[i], b.visc[i], p_tr, tau_tr, b.g_max[i], b.g_max[i], b.tu[i]};
-          tj_point[n_tj++] = i;
-      }
+    batch_closed(b, m);
+    int n_f1 = 0, n_tj = 0;
+    for (int i = 0; i < m; ++i) {  // (branch-free compaction)
+      const bool v = b.ok[i] != 0.0;
+      f1_point[n_f1] = i;
+      n_f1 += v && b.kind[i] == kF1Solve ? 1 : 0;
+      tj_point[n_tj] = i;
+      n_tj += v && b.kind[i] == kTensionSolve ? 1 : 0;
     }
+    // A point's return map from return_map() itself (a failed lane solve), into the block's arrays
+    auto store_scalar = [&](int i, const ReturnMap& r) {
+      b.r_tau[i] = r.tau, b.r_p[i] = r.p, b.r_g[i] = r.g, b.r_xi1[i] = r.xi1, b.r_xi2[i] = r.xi2;
+      b.r_res[i] = r.residual, b.r_reg[i] = static_cast<double>(r.regime), b.r_it[i] = r.iterations;
+      b.r_ok[i] = r.converged ? 1.0 : 0.0;
+    };
     // ---- (3) the Newton solves in lanes; results per job ----
     struct Result {
       double g, p, u, R;
       int status;  // 1 converged, 2 failed, 3 (tension) step converged: check below
     };
-    Result res_f1[kBlock], res_tj[kBlock];
+    Result res[kBlock];
     SolveLanes<N> s;
     // (3a) f_1-only branch: Newton in u with bracket [lo, hi] (return_map's scalar loop, same steps)
     run_lanes<N>(
         n_f1,
         [&](int l, int j) {
-          const F1Job& jb = f1[j];
-          s.load(l, jb.phi, jb.phi_m, jb.a, jb.visc, jb.p_tr, jb.tau_tr);
-          s.x[l] = jb.x, s.lo[l] = jb.lo, s.hi[l] = jb.hi;
+          const int i = f1_point[j];
+          s.load(l, b.s_phi[i], b.phi_m[i], b.a[i], b.visc[i], b.s_p_tr[i], b.s_tau_tr[i]);
+          s.x[l] = b.x[i], s.lo[l] = b.lo[i], s.hi[l] = b.hi[i];
         },
         [&] { f1_lanes_value<N>(c, s); },
         [&](int l, int j) {
@@ -1201,89 +1209,86 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
             }
             if (st == 0 && s.it[l] < cap) return false;
             if (st == 0) {  // iteration cap
-              res_f1[j] = Result{0.0, 0.0, 0.0, 0.0, 2};
+              res[j] = Result{0.0, 0.0, 0.0, 0.0, 2};
               return true;
             }
           }
-          res_f1[j] = Result{s.g[l], s.p[l], s.x[l], s.R[l], 1};
+          res[j] = Result{s.g[l], s.p[l], s.x[l], s.R[l], 1};
           return true;
         });
+    for (int k = 0; k < n_f1; ++k) {  // the solved return maps' ends (the scalar path for a failed job)
+      const int i = f1_point[k];
+      const std::int64_t q = b0 + i;
+      const Result& r = res[k];
+      const double tau_tr = b.s_tau_tr[i];
+      const double residual = std::fabs(r.R) / tau_tr;
+      if (r.status == 1 && residual <= 1e-10) {
+        b.r_g[i] = r.g;
+        b.r_p[i] = r.p;
+        b.r_res[i] = residual;
+        b.r_reg[i] = static_cast<double>(GranularRegime::kShear);
+        // tau_bar from the friction side of E21: accurate even when G dt g >> tau_bar
+        b.r_tau[i] = std::min(friction_of(c, b.s_phi[i], b.phi_m[i], b.a[i], b.visc[i], r.g, r.p, r.u), tau_tr);
+      } else {
+        store_scalar(i, return_map(f[q], phi[q], eta_0_, dt, b.s_p_tr[i], tau_tr));  // the scalar path and its fallback
+      }
+    }
     // (3b) p_tr <= 0 fast path: Newton on (gamma_dot, u), at most kTensionIterations steps
     run_lanes<N>(
         n_tj,
         [&](int l, int j) {
-          const TensionJob& jb = tj[j];
-          s.load(l, jb.phi, jb.phi_m, jb.a, jb.visc, jb.p_tr, jb.tau_tr);
-          s.g_max[l] = jb.g_max, s.g[l] = jb.g, s.x[l] = jb.u;
+          const int i = tj_point[j];
+          s.load(l, b.s_phi[i], b.phi_m[i], b.a[i], b.visc[i], b.s_p_tr[i], b.s_tau_tr[i]);
+          s.g_max[l] = b.g_max[i], s.g[l] = b.g_max[i], s.x[l] = b.tu[i];
         },
         [&] { tension_lanes_step<N>(c, tol, s); },
         [&](int l, int j) {
           ++s.it[l];
           const int st = static_cast<int>(s.status[l]);
           if (st == 0 && s.it[l] < kTensionIterations) return false;
-          res_tj[j] = Result{s.g[l], s.p[l], s.x[l], s.R[l], st == 0 ? 2 : st};
+          res[j] = Result{s.g[l], s.p[l], s.x[l], s.R[l], st == 0 ? 2 : st};
           return true;
         });
-    // the solved return maps' ends (the scalar path for a job that failed)
-    for (int k = 0; k < n_f1; ++k) {
-      const int i = f1_point[k];
-      const std::int64_t q = b0 + i;
-      const Result& r = res_f1[k];
-      const F1Job& jb = f1[k];
-      const double residual = std::fabs(r.R) / jb.tau_tr;
-      if (r.status == 1 && residual <= 1e-10) {
-        ReturnMap& o = rm[i];
-        o = ReturnMap{};
-        o.g = r.g;
-        o.p = r.p;
-        o.residual = residual;
-        o.regime = GranularRegime::kShear;
-        // tau_bar from the friction side of E21: accurate even when G dt g >> tau_bar
-        o.tau = std::min(friction_of(c, jb.phi, jb.phi_m, jb.a, jb.visc, r.g, r.p, r.u), jb.tau_tr);
-      } else {
-        rm[i] = return_map(f[q], phi[q], eta_0_, dt, jb.p_tr, jb.tau_tr);  // the scalar path and its fallback
-      }
-    }
     for (int k = 0; k < n_tj; ++k) {
       const int i = tj_point[k];
       const std::int64_t q = b0 + i;
-      const Result& r = res_tj[k];
-      const TensionJob& jb = tj[k];
+      const Result& r = res[k];
+      const double ph = b.s_phi[i], phi_m = b.phi_m[i], a = b.a[i], visc = b.visc[i];
+      const double p_tr = b.s_p_tr[i], tau_tr = b.s_tau_tr[i];
       bool fast = r.status == 1;
-      double gg = r.g, uu = r.u, pp = r.p, residual = std::fabs(r.R) / jb.tau_tr;
+      double gg = r.g, uu = r.u, pp = r.p, residual = std::fabs(r.R) / tau_tr;
       if (r.status == 3)  // return_map's check after a converged step
-        fast = tension_accept(c, jb.phi, jb.phi_m, jb.a, jb.visc, jb.p_tr, jb.tau_tr, gg, uu, pp, residual);
+        fast = tension_accept(c, ph, phi_m, a, visc, p_tr, tau_tr, gg, uu, pp, residual);
       if (!fast) {
-        rm[i] = return_map(f[q], phi[q], eta_0_, dt, jb.p_tr, jb.tau_tr);  // the nested solve
+        store_scalar(i, return_map(f[q], phi[q], eta_0_, dt, p_tr, tau_tr));  // the nested solve
         continue;
       }
-      ReturnMap& o = rm[i];
-      o = ReturnMap{};
-      o.g = gg;
-      o.p = pp;
-      o.residual = residual;
-      o.tau = std::min(friction_of(c, jb.phi, jb.phi_m, jb.a, jb.visc, gg, pp, uu), jb.tau_tr);
-      o.regime = pp > 0.0 ? GranularRegime::kShear : GranularRegime::kSeparated;
-      if (pp <= 0.0) o.xi1 = std::max(-jb.p_tr / c.Kdt - K_3_ * jb.phi * gg, 0.0);
+      b.r_g[i] = gg;
+      b.r_p[i] = pp;
+      b.r_res[i] = residual;
+      b.r_tau[i] = std::min(friction_of(c, ph, phi_m, a, visc, gg, pp, uu), tau_tr);
+      b.r_reg[i] = static_cast<double>(pp > 0.0 ? GranularRegime::kShear : GranularRegime::kSeparated);
+      b.r_xi1[i] = pp <= 0.0 ? std::max(-p_tr / c.Kdt - K_3_ * ph * gg, 0.0) : 0.0;
     }
     // ---- (4) the ends of the updates in lanes; finish() itself where they cannot be ----
-    for (int i = 0; i < m; ++i) {
-      b.r_tau[i] = rm[i].tau, b.r_p[i] = rm[i].p, b.r_g[i] = rm[i].g;
-      b.r_ok[i] = valid[i] && rm[i].converged ? 1.0 : 0.0;
-    }
     batch_finish(kc, b, m);
     for (int i = 0; i < m; ++i) {
       const std::int64_t q = b0 + i;
-      if (!valid[i]) {
+      if (b.ok[i] == 0.0) {
         step[q] = GranularStep{GranularRegime::kElastic, false, 0.0};
         continue;
       }
+      const auto regime = static_cast<GranularRegime>(static_cast<int>(b.r_reg[i]));
       if (b.e_fast[i] != 0.0) {
-        step[q] = GranularStep{rm[i].regime, true, rm[i].g};
+        step[q] = GranularStep{regime, true, b.r_g[i]};
         for (int k = 0; k < 9; ++k) sigma[q].data()[k] = b.e_sig[k][i];
         f[q] = b.e_f[i];
         continue;
       }
+      ReturnMap rr;
+      rr.tau = b.r_tau[i], rr.p = b.r_p[i], rr.g = b.r_g[i], rr.xi1 = b.r_xi1[i], rr.xi2 = b.r_xi2[i];
+      rr.residual = b.r_res[i], rr.regime = regime, rr.converged = b.r_ok[i] != 0.0;
+      rr.iterations = static_cast<int>(b.r_it[i]);
       GranularState st;
       for (int k = 0; k < 9; ++k) st.sigma.data()[k] = sigma[q].data()[k];
       st.f = f[q];
@@ -1294,7 +1299,7 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
       t.fm = b.t_fm[i];
       t.inv_eta_B = b.t_inv_eta_B[i];
       GranularUpdate out;
-      finish<false>(st, t, rm[i], dt, phi[q], eta_0_, out);
+      finish<false>(st, t, rr, dt, phi[q], eta_0_, out);
       step[q] = GranularStep{out.regime, out.ok(), out.gamma_dot_p};
       if (!out.ok()) continue;
       for (int k = 0; k < 9; ++k) sigma[q].data()[k] = st.sigma.data()[k];

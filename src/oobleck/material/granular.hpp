@@ -166,16 +166,6 @@ class GranularLaw {
     Eigen::Matrix3d s;  ///< deviator of the trial stress [Pa]
     double p_tr, tau_tr, fm, inv_eta_B;
   };
-  /// The f_1-only Newton solve in u = I_m (return_map) as data: per-point constants, start, bracket.
-  struct F1Job {
-    double phi, phi_m, a, visc, p_tr, tau_tr;
-    double x, lo, hi;
-  };
-  /// The p_tr <= 0 fast path's Newton solve on (gamma_dot, I_m) (return_map) as data.
-  struct TensionJob {
-    double phi, phi_m, a, visc, p_tr, tau_tr, g_max;
-    double g, u;  ///< start
-  };
   static constexpr int kTensionIterations = 8;  ///< Newton steps of the fast path before the nested solve
   template <bool kDiagnostics>
   GranularUpdate update_impl(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W, double dt,
@@ -196,7 +186,8 @@ class GranularLaw {
               GranularUpdate& out) const;
   /// E17–E23 at structure f for a given trial (p_tr, tau_tr): allocation-free, never throws.
   /// (advance_batch takes its branches, closed forms and Newton starts in lanes with the same inline
-  /// functions, runs the Newton solves as F1Job/TensionJob in lanes, and calls it where those fail.)
+  /// functions, runs the Newton solves (the f_1-only solve and the p_tr <= 0 fast path) in lanes,
+  /// and calls it where those fail.)
   ReturnMap return_map(double f, double phi, double eta_0, double dt, double p_tr, double tau_tr) const;
 
   rheology::SteadyParams steady_;

@@ -228,9 +228,10 @@ class Solver {
       StepClock clock(timings_);
       apply_motors();                      // 3'. wheel motor (velocity level, §8) before P2G
       particles_to_grid_all<K>();          // 1. N_ip, ∇N_ip cached per point, fused with
-                                           // 2. mass, momentum, internal force
+                                           // 2. mass, momentum, internal force, and
+                                           // 3. gravity (in the pass over the nodes that sums
+                                           //    the threads' copies; motors later)
       clock.lap(timings_.p2g);
-      apply_body_loads();                  // 3. gravity (motors later)
       fold_wall_images_all();              // 4a. walls: ghost contributions onto mirrors
       update_grid_and_couple();            // per node, fused: 3a. porosity n_i, buoyancy split
                                            // E28, ∇p_0; 5. v = (mv + Δt f)/m with all non-drag
@@ -281,8 +282,8 @@ class Solver {
     }
   }
 
-  /// Steps 1–2 for every body: each point's shape functions (into its body's cache) and its
-  /// scatter (particles_to_grid).
+  /// Steps 1–3 for every body: each point's shape functions (into its body's cache), its scatter
+  /// and gravity on the nodal masses (particles_to_grid).
   template <int K>
   void particles_to_grid_all() {
     omp_set_num_threads(threads_);
@@ -291,7 +292,7 @@ class Solver {
       const std::int64_t bad = with_kernel(opt_.shape, opt_.gimp_half_width_cells, [&](auto kernel) -> std::int64_t {
         if constexpr (decltype(kernel)::support == support_of<D>(K))
           return particles_to_grid<G, K>(*bodies_[b], grid_, kernel, caches_[b], fields_[b], apic,
-                                         static_cast<int>(b) == fluid_);
+                                         static_cast<int>(b) == fluid_, &opt_.gravity_m_s2);
         else
           return 0;  // not reached: with_support and with_kernel read the same option
       });
@@ -316,13 +317,17 @@ class Solver {
   ///    F_d = C_i/(1 + Δt C_i (1/m_s + 1/m_f)) Δv; grains −F_d, fluid +F_d.
   void update_grid_and_couple() {
     const double dt = opt_.dt_s;
+    // Deformable solids (the wheel): their predictions join the mixture's pass over the nodes
+    // below when there is a fluid; otherwise they get their own pass.
+    solids_.clear();
     for (int b = 0; b < body_count(); ++b) {
       if (rigid_[b].rigid())
         predict_rigid(rigid_[b], *bodies_[b], fields_[b], opt_.gravity_m_s2, dt);
       else if (b != grains_ && b != fluid_)
-        update_grid_velocity(fields_[b], dt);
+        solids_.push_back(&fields_[b]);
     }
     if (fluid_ < 0) {
+      for (GridField<G>* sf : solids_) update_grid_velocity(*sf, dt);
       if (grains_ >= 0) update_grid_velocity(fields_[grains_], dt);
       return;
     }
@@ -347,6 +352,8 @@ class Solver {
         Re_b[j] = 0.0;
         drag[j] = false;
       }
+      for (GridField<G>* sf : solids_)
+        for (int j = 0; j < nb; ++j) predict_node(*sf, i0 + j, dt);
       for (int j = 0; j < nb; ++j) {
         const int i = i0 + j;
         const double V = f.volume_m3[i], ms = grains ? s.mass_kg[i] : 0.0, mf = f.mass_kg[i];
@@ -489,11 +496,6 @@ class Solver {
     }
   }
 
-  void apply_body_loads() {
-    if (opt_.gravity_m_s2.squaredNorm() == 0.0) return;
-    for (auto& f : fields_) add_gravity(f, opt_.gravity_m_s2);
-  }
-
   void fold_wall_images_all() {
     for (auto& f : fields_) fold_wall_images<G>(grid_, bc_, f);
   }
@@ -542,6 +544,7 @@ class Solver {
   int threads_ = 1;
   int grains_ = -1, fluid_ = -1;
   StepTimings timings_;
+  std::vector<GridField<G>*> solids_;  ///< fields of the deformable solids (update_grid_and_couple)
   std::vector<double> porosity_;  ///< nodal porosity n_i of the mixture
   std::vector<Vec<NC>> flux_;     ///< nodal mixture volume flux q_i
   double time_s_ = 0.0;

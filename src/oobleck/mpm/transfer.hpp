@@ -237,11 +237,21 @@ inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim
 
 }  // namespace detail
 
+/// Body loads (model.md §6 step 3): gravity f_i += m_i g.
+template <class G>
+void add_gravity(GridField<G>& field, const Vec<G::ncomp>& g_m_s2) {
+  const int nn = field.nodes();
+#pragma omp parallel for schedule(static) if (nn >= kParallelMinNodes)
+  for (int i = 0; i < nn; ++i) field.force_N[i] += field.mass_kg[i] * g_m_s2;
+}
+
 /// P2G (model.md §6 step 2): nodal mass, momentum (with the APIC affine term when `apic`),
 /// internal force f_i = −∑_p V_p σ_p ∇N_ip, and external point loads ∑_p N_ip f_ext,p. K = local nodes per point (support^dim).
 /// With `split_pressure` (the fluid phase) the stress is split as σ = τ − p 1 (p = −tr σ/3): the
 /// internal force gets only τ, the pressure part ∑ V_p p_p ∇N_ip goes to `pressure_force_N` for the
-/// buoyancy split (E28), and the nodal mixture volume ∑ N_ip V_p is accumulated.
+/// buoyancy split (E28), and the nodal mixture volume ∑ N_ip V_p is accumulated. With
+/// `gravity_m_s2`, the body load of step 3 follows, f_i += m_i g (in the pass that sums the
+/// threads' copies: the same values as add_gravity afterwards).
 ///
 /// The shape functions of the step (model.md §6 step 1) are computed here, point by point, with
 /// the same make_stencil as compute_shape_cache, and stored in `cache` for the rest of the step
@@ -250,7 +260,8 @@ inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim
 /// the caller stops the run).
 template <class G, int K, class Kernel>
 std::int64_t particles_to_grid(const Body<G>& body, const Grid<G::dim>& grid, const Kernel& kernel,
-                               ShapeCache<G::dim>& cache, GridField<G>& field, bool apic, bool split_pressure = false) {
+                               ShapeCache<G::dim>& cache, GridField<G>& field, bool apic, bool split_pressure = false,
+                               const Vec<G::ncomp>* gravity_m_s2 = nullptr) {
   constexpr int NC = G::ncomp, S = support_of<G::dim>(K);
   static_assert(Kernel::support == S);
   const std::int64_t np = body.size();
@@ -299,7 +310,10 @@ std::int64_t particles_to_grid(const Body<G>& body, const Grid<G::dim>& grid, co
       else scatter.template operator()<false, false>();
     }
   }
+  const bool gravity = gravity_m_s2 != nullptr && gravity_m_s2->squaredNorm() != 0.0;
   if (team > 1) {
+    // The copies' sums, and the body load of step 3 (gravity) on the summed mass in the same pass.
+    const Vec<NC> g = gravity ? *gravity_m_s2 : Vec<NC>::Zero();
 #pragma omp parallel for schedule(static) num_threads(team) if (nn >= kParallelMinNodes / 8)  // ~5 ns per node and copy
     for (int i = 0; i < nn; ++i) {
       for (int t = 1; t < team; ++t) {
@@ -311,17 +325,12 @@ std::int64_t particles_to_grid(const Body<G>& body, const Grid<G::dim>& grid, co
           field.volume_m3[i] += field.t_volume[t - 1][i];
         }
       }
+      if (gravity) field.force_N[i] += field.mass_kg[i] * g;
     }
+  } else if (gravity) {
+    add_gravity(field, *gravity_m_s2);
   }
   return bad;
-}
-
-/// Body loads (model.md §6 step 3): gravity f_i += m_i g.
-template <class G>
-void add_gravity(GridField<G>& field, const Vec<G::ncomp>& g_m_s2) {
-  const int nn = field.nodes();
-#pragma omp parallel for schedule(static) if (nn >= kParallelMinNodes)
-  for (int i = 0; i < nn; ++i) field.force_N[i] += field.mass_kg[i] * g_m_s2;
 }
 
 /// Grid update (model.md §6 step 5): v_old = mv/m, v = (mv + Δt f)/m on nodes with mass.
