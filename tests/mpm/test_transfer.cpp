@@ -224,3 +224,57 @@ void check_all_kernels() {
 TEST(Transfer, PlaneStrainP2GAndG2PEqualTheNodeByNodeSums) { check_all_kernels<PlaneStrain>(); }
 
 TEST(Transfer, AxisymmetricP2GAndG2PEqualTheNodeByNodeSums) { check_all_kernels<Axisymmetric>(); }
+
+// Step 3 inside P2G: with gravity_m_s2, the nodal forces are those of P2G followed by a separate
+// add_gravity pass, bit for bit, on one thread (the separate pass) and on two (gravity in the pass
+// that sums the threads' copies); masses and momenta are untouched.
+template <class G>
+void check_gravity_in_p2g(int threads) {
+  constexpr int D = G::dim, NC = G::ncomp, K = 9;
+  Setup<G> st(21u);
+  const int nn = st.grid.node_count();
+  const QuadraticBSplineKernel kernel{};
+  Vec<NC> g = Vec<NC>::Zero();
+  g[1] = -9.81;
+  g[0] = 0.37;  // a second component, so that both lanes of the pairs are checked
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(threads);
+  GridField<G> with, sep;
+  with.resize(nn, threads);
+  sep.resize(nn, threads);
+  ShapeCache<D> c1, c2;
+  ASSERT_EQ((particles_to_grid<G, K>(st.body, st.grid, kernel, c1, with, true, true, &g)), 0);
+  ASSERT_EQ((particles_to_grid<G, K>(st.body, st.grid, kernel, c2, sep, true, true)), 0);
+  add_gravity(sep, g);
+  omp_set_num_threads(saved);
+  double f_max = 0.0;
+  for (int i = 0; i < nn; ++i) {
+    ASSERT_EQ(with.mass_kg[i], sep.mass_kg[i]) << "node " << i;
+    for (int c = 0; c < NC; ++c) {
+      ASSERT_EQ(with.momentum[i][c], sep.momentum[i][c]) << "node " << i;
+      ASSERT_EQ(with.force_N[i][c], sep.force_N[i][c]) << "node " << i << ", component " << c;
+      f_max = std::max(f_max, std::fabs(with.force_N[i][c]));
+    }
+  }
+  // and gravity is there: the total force is the points' total weight plus the internal and
+  // external forces, which P2G without gravity gives
+  GridField<G> none;
+  none.resize(nn, threads);
+  ShapeCache<D> c3;
+  ASSERT_EQ((particles_to_grid<G, K>(st.body, st.grid, kernel, c3, none, true, true)), 0);
+  Vec<NC> F_with = Vec<NC>::Zero(), F_none = Vec<NC>::Zero();
+  for (int i = 0; i < nn; ++i) {
+    F_with += with.force_N[i];
+    F_none += none.force_N[i];
+  }
+  const Vec<NC> W = st.body.total_mass() * g;
+  for (int c = 0; c < NC; ++c) EXPECT_NEAR(F_with[c] - F_none[c], W[c], 1e-12 * (f_max * nn + std::fabs(W[c])));
+}
+
+TEST(Transfer, GravityInP2GEqualsTheSeparatePassOnOneAndTwoThreads) {
+  for (int threads : {1, 2}) {
+    SCOPED_TRACE(threads);
+    check_gravity_in_p2g<PlaneStrain>(threads);
+    check_gravity_in_p2g<Axisymmetric>(threads);
+  }
+}

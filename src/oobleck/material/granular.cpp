@@ -1183,7 +1183,7 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
       b.r_res[i] = r.residual, b.r_reg[i] = static_cast<double>(r.regime), b.r_it[i] = r.iterations;
       b.r_ok[i] = r.converged ? 1.0 : 0.0;
     };
-    // ---- (3) the Newton solves in lanes; results per job ----
+    // ---- (3) the Newton solves in lanes; a result per listed point (res[k] for point list[k]) ----
     struct Result {
       double g, p, u, R;
       int status;  // 1 converged, 2 failed, 3 (tension) step converged: check below

@@ -124,9 +124,12 @@ Vec<D> periodic_difference(const Grid<D>& grid, const Vec<D>& x, const Vec<D>& x
   for (int a = 0; a < D; ++a) {
     if (!grid.periodic[a]) continue;
     const double L = grid.length(a);
-    // Within 0.49 L, round(d/L) is 0 and d keeps its value: no division and no libm call for
-    // the usual case (a per-point test of the contact scatters).
-    if (std::fabs(d[a]) < 0.49 * L) continue;
+    // Within 0.49 L, round(d/L) is ±0 and d − L round(d/L) = d + 0 (a −0 difference becomes +0):
+    // no division and no libm call for the usual case (a per-point test of the contact scatters).
+    if (std::fabs(d[a]) < 0.49 * L) {
+      d[a] += 0.0;
+      continue;
+    }
     d[a] -= L * std::round(d[a] / L);
   }
   return d;

@@ -544,7 +544,7 @@ class Solver {
   int threads_ = 1;
   int grains_ = -1, fluid_ = -1;
   StepTimings timings_;
-  std::vector<GridField<G>*> solids_;  ///< fields of the deformable solids (update_grid_and_couple)
+  std::vector<GridField<G>*> solids_;  ///< scratch of update_grid_and_couple (refilled per call): deformable solids' fields
   std::vector<double> porosity_;  ///< nodal porosity n_i of the mixture
   std::vector<Vec<NC>> flux_;     ///< nodal mixture volume flux q_i
   double time_s_ = 0.0;
