@@ -1031,17 +1031,21 @@ struct BatchBlock {
   constexpr double kSep = static_cast<double>(GranularRegime::kSeparated);
   constexpr double kSC = static_cast<double>(GranularRegime::kShearCompaction);
   constexpr double kC = static_cast<double>(GranularRegime::kCompaction);
+  // (GCC 12 leaves this loop scalar, "control flow in loop", with or without omp simd, like the
+  // branch decision in batch_classify; the inputs are loaded unconditionally all the same)
   for (int i = 0; i < m; ++i) {
     const double k = b.kind[i], p_tr = b.s_p_tr[i], tau_tr = b.s_tau_tr[i];
+    const double c_tau = b.c_tau[i], c_p = b.c_p[i], c_g = b.c_g[i], c_xi2 = b.c_xi2[i];
+    const double g_max = b.g_max[i], xi1 = b.xi1[i];
     const bool el = k == kElasticTrial, cf = k == kClosedForm, sep = k == kSeparatedForm;
-    b.r_tau[i] = el ? tau_tr : (cf ? b.c_tau[i] : 0.0);
-    b.r_p[i] = el ? p_tr : (cf ? b.c_p[i] : 0.0);
-    const double g_sep = tau_tr > 0.0 ? b.g_max[i] : 0.0;
-    b.r_g[i] = cf ? b.c_g[i] : (sep ? g_sep : 0.0);
-    b.r_xi1[i] = sep ? b.xi1[i] : 0.0;
-    b.r_xi2[i] = cf ? b.c_xi2[i] : 0.0;
-    const double reg_cf = b.c_g[i] > 0.0 ? kSC : kC;
-    const double reg_sep = (tau_tr > 0.0 || p_tr < 0.0) ? kSep : kEl;
+    b.r_tau[i] = el ? tau_tr : (cf ? c_tau : 0.0);
+    b.r_p[i] = el ? p_tr : (cf ? c_p : 0.0);
+    const double g_sep = tau_tr > 0.0 ? g_max : 0.0;
+    b.r_g[i] = cf ? c_g : (sep ? g_sep : 0.0);
+    b.r_xi1[i] = sep ? xi1 : 0.0;
+    b.r_xi2[i] = cf ? c_xi2 : 0.0;
+    const double reg_cf = c_g > 0.0 ? kSC : kC;
+    const double reg_sep = ((tau_tr > 0.0) | (p_tr < 0.0)) ? kSep : kEl;
     b.r_reg[i] = cf ? reg_cf : (sep ? reg_sep : kEl);
     b.r_res[i] = 0.0;
     b.r_it[i] = 0.0;
