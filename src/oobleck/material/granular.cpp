@@ -993,16 +993,15 @@ struct BatchBlock {
     b.dil_p[i] = p_tr + dil * g_max;
     b.e_lo[0][i] = e.g, b.e_lo[1][i] = e.p, b.e_lo[2][i] = e.R, b.e_lo[3][i] = e.be, b.e_lo[4][i] = e.mq;
     b.e_lo[5][i] = e.disc;
-    const double tu = tension_start(c, phi_m, a, p_tr, dil, g_max);
     const double g_sep = tau_tr > 0.0 ? g_max : 0.0;
     const double xi1 = -p_tr / c.Kdt - c.K_3 * ph * g_sep;  // E22: p = p_tr + K dt (beta g + xi_1) = 0
     b.xi1[i] = xi1 < 0.0 ? 0.0 : xi1;
     b.phi_m[i] = phi_m, b.a[i] = a, b.visc[i] = visc, b.lo[i] = u_eq;
-    b.g_max[i] = g_max, b.tu[i] = tu;
+    b.g_max[i] = g_max;
   }
   // The branch (a loop of its own: in the loop above, GCC 12 finds no vector type once these
   // selects are in it)
-  int f1_solves = 0;
+  int f1_solves = 0, tension_solves = 0;
   for (int i = 0; i < m; ++i) {
     const double ph = b.s_phi[i], p_tr = b.s_p_tr[i], tau_tr = b.s_tau_tr[i];
     // p_tr > 0: elastic (f_1 and f_3 inactive at the trial), the f_1 + f_3 closed form, or the f_1 solve
@@ -1012,6 +1011,16 @@ struct BatchBlock {
     const double kind_t = tau_tr > 0.0 && b.dil_p[i] > 0.0 ? kTensionSolve : kSeparatedForm;
     b.kind[i] = p_tr > 0.0 ? kind_c : kind_t;
     f1_solves += b.kind[i] == kF1Solve ? 1 : 0;
+    tension_solves += b.kind[i] == kTensionSolve ? 1 : 0;
+  }
+  // The p_tr <= 0 fast path's starts (a square root and two divisions per lane), only in blocks
+  // that have such a solve
+  if (tension_solves > 0) {
+#pragma omp simd
+    for (int i = 0; i < m; ++i) {
+      const double dil = c.Kdt * c.K_3 * b.s_phi[i];
+      b.tu[i] = tension_start(c, b.phi_m[i], b.a[i], b.s_p_tr[i], dil, b.g_max[i]);
+    }
   }
   // The f_1 solves' starts (a quarter of the loop above), only in blocks that have such a solve
   if (f1_solves == 0) return;
