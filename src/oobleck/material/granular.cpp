@@ -298,6 +298,13 @@ inline double tension_start(const F1Consts& c, double phi_m, double a, double p_
   return p_tr < 0.0 && u_q < u_0 ? u_0 : u_q;  // std::max(u_q, u_0) for p_tr < 0
 }
 
+/// E22 for a separated point (p = 0): p = p_tr + K dt (beta gamma_dot + xi_1) = 0 with beta = K_3 phi,
+/// xi_1 = max(-p_tr/(K dt) - K_3 phi gamma_dot, 0). Branch-free (return_map and the lanes).
+inline double separated_xi1(const F1Consts& c, double phi, double p_tr, double g) {
+  const double xi1 = -p_tr / c.Kdt - c.K_3 * phi * g;
+  return xi1 < 0.0 ? 0.0 : xi1;  // std::max(xi1, 0.0)
+}
+
 /// E24 linearly implicit with the end-of-step tau_bar, gamma_dot^p: f = (f_n + dt H' f_m)/(1 + dt (H' + S')),
 /// H' = K_0 gamma_dot^p (tau_bar/tau*)^{3/2}, S' = K_0 (gamma_dot^p + tau_bar/eta_B + xi_dot_eps);
 /// `stiff` = dt (H' + S'). Branch-free (GranularLaw::finish and the lanes of advance_batch).
@@ -578,7 +585,7 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
       g = tau_tr > 0.0 ? g_max : 0.0;
       tau = 0.0;
       p = 0.0;
-      xi1 = std::max(-p_tr / Kdt - K_3_ * phi * g, 0.0);  // E22: p = p_tr + K dt (beta g + xi_1) = 0
+      xi1 = separated_xi1(c, phi, p_tr, g);  // E22
     } else {
       // flow with p > 0 created by dilatancy (a loose bed that dilates slightly, or a stress-free
       // dense state that is sheared). Fast path: Newton on the pair (gamma_dot, u = I_m) for the
@@ -623,7 +630,7 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
       if (!fast) solve_g(std::max(-p_tr / dil, 0.0), g_max);
       tau = std::min(friction(g, p, u), tau_tr);
       regime = p > 0.0 ? GranularRegime::kShear : GranularRegime::kSeparated;
-      if (p <= 0.0) xi1 = std::max(-p_tr / Kdt - K_3_ * phi * g, 0.0);
+      if (p <= 0.0) xi1 = separated_xi1(c, phi, p_tr, g);
     }
   }
 
@@ -1015,8 +1022,7 @@ inline void gather_components(const Eigen::Matrix3d* mats, int m, double (*out)[
     b.e_lo[0][i] = e.g, b.e_lo[1][i] = e.p, b.e_lo[2][i] = e.R, b.e_lo[3][i] = e.be, b.e_lo[4][i] = e.mq;
     b.e_lo[5][i] = e.disc;
     const double g_sep = tau_tr > 0.0 ? g_max : 0.0;
-    const double xi1 = -p_tr / c.Kdt - c.K_3 * ph * g_sep;  // E22: p = p_tr + K dt (beta g + xi_1) = 0
-    b.xi1[i] = xi1 < 0.0 ? 0.0 : xi1;
+    b.xi1[i] = separated_xi1(c, ph, p_tr, g_sep);  // E22
     b.phi_m[i] = phi_m, b.a[i] = a, b.visc[i] = visc, b.lo[i] = u_eq;
     b.g_max[i] = g_max;
   }
@@ -1302,7 +1308,7 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
       b.r_res[i] = residual;
       b.r_tau[i] = std::min(friction_of(c, ph, phi_m, a, visc, gg, pp, uu), tau_tr);
       b.r_reg[i] = static_cast<double>(pp > 0.0 ? GranularRegime::kShear : GranularRegime::kSeparated);
-      b.r_xi1[i] = pp <= 0.0 ? std::max(-p_tr / c.Kdt - K_3_ * ph * gg, 0.0) : 0.0;
+      b.r_xi1[i] = pp <= 0.0 ? separated_xi1(c, ph, p_tr, gg) : 0.0;
     }
     // ---- (4) the ends of the updates in lanes; finish() itself where they cannot be ----
     batch_finish(kc, b, m);
