@@ -191,8 +191,10 @@ inline void f1_value(const F1Consts& c, double phi, double phi_m, double a, doub
   const double B2 = c.two_eta - c.Kdt * e.be * uu * uu;
   const double C2 = p_tr * uu * uu;
   e.disc = std::sqrt(B2 * B2 + 4.0 * A2 * C2);
-  const double g_plus = 2.0 * C2 / (B2 + e.disc), g_minus = (e.disc - B2) / (2.0 * A2);
-  e.g = B2 >= 0.0 ? g_plus : g_minus;
+  // g_+ = 2 C2/(B2 + disc) for B2 >= 0, g_- = (disc - B2)/(2 A2) otherwise: the operands selected
+  // before the one division (in the lanes both quotients were computed; the divider bounds them)
+  const bool plus = B2 >= 0.0;
+  e.g = (plus ? 2.0 * C2 : e.disc - B2) / (plus ? B2 + e.disc : 2.0 * A2);
   e.p = p_tr + c.Kdt * e.be * e.g;
   e.mq = f1_mu_q(c, uu);  // E20 mu_q
   // viscous friction term of E20 times p: (5/2) phi/a * I_v/I_m * p = visc * g/u
@@ -277,9 +279,12 @@ inline void f1_start(const F1Consts& c, double mu0, double phi, double phi_m, do
   const double qa = c1 * a, qb = c1 - r * a, qc = -(r + c.K_3 * phi_m);
   const double disc = qb * qb - 4.0 * qa * qc;
   const double sq = std::sqrt(disc);
-  const double x_a = (-qb + sq) / (2.0 * qa), x_b = -2.0 * qc / (qb + sq);  // the positive root, stably
+  // the positive root, stably: (-qb + sq)/(2 qa) for qb <= 0, else -2 qc/(qb + sq) (operands
+  // selected before the one division)
+  const bool ra = qb <= 0.0;
+  const double x_ab = (ra ? -qb + sq : -2.0 * qc) / (ra ? 2.0 * qa : qb + sq);
   const double mid = 0.5 * (lo + hi);
-  const double x_q = ((qc < 0.0) & (disc >= 0.0)) ? (qb <= 0.0 ? x_a : x_b) : mid;
+  const double x_q = ((qc < 0.0) & (disc >= 0.0)) ? x_ab : mid;
   const double x_in = ((x_q > lo) & (x_q < hi)) ? x_q : mid;
   const double xn = lo - e_lo.R / e_lo_dR;
   x = ((e_lo_dR < 0.0) & (xn > lo) & (xn < x_in)) ? xn : x_in;
@@ -1016,7 +1021,9 @@ inline void gather_components(const Eigen::Matrix3d* mats, int m, double (*out)[
     const double dil = c.Kdt * c.K_3 * ph;
     F1Value e;
     compressive(c, ph, phi_m, a, visc, p_tr, tau_tr, u_eq, e, b.c_g[i], b.c_p[i], b.c_tau[i], b.c_xi2[i]);
-    const double fr0 = (mu0 + c.K_3 * (ph - phi_m / (1.0 + a * 0.0))) * p_tr;
+    // return_map's beta_of(0) = K_3 (phi - phi_m/(1 + a 0)): phi_m/1 = phi_m exactly (a is finite
+    // for valid f), so no division here
+    const double fr0 = (mu0 + c.K_3 * (ph - phi_m)) * p_tr;
     b.f1_trial[i] = tau_tr - (fr0 < 0.0 ? 0.0 : fr0);  // E21 at gamma_dot = 0 (std::max(fr0, 0))
     b.dil_p[i] = p_tr + dil * g_max;
     b.e_lo[0][i] = e.g, b.e_lo[1][i] = e.p, b.e_lo[2][i] = e.R, b.e_lo[3][i] = e.be, b.e_lo[4][i] = e.mq;
