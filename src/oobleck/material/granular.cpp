@@ -132,6 +132,36 @@ inline void jaumann_trial(const T9& S, const T9& D, const T9& W, double dt, doub
   for (int i = 0; i < 3; ++i) r.v[4 * i] += vol;
 }
 
+/// jaumann_trial for a point in plane motion: the xz and yz entries of S, D and W (T9 indices 2, 5,
+/// 6, 7) are zero, D_zz = D.v[8] is any value (plane strain: 0). jaumann_trial's sums without
+/// their zero products, in the same order: the in-plane entries and zz are the same values (a sum
+/// with a zero product changes at most the sign of a zero), and the four out-of-plane entries are
+/// +0.
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void jaumann_trial_plane(const T9& S, const T9& D, const T9& W, double dt, double G, double K, T9& r) {
+  const double two_G = 2.0 * G;
+  auto at = [](const T9& m, int i, int j) { return m.v[i + 3 * j]; };
+  for (int j = 0; j < 2; ++j) {
+    for (int i = 0; i < 2; ++i) {
+      const double ws = at(W, i, 0) * at(S, 0, j) + at(W, i, 1) * at(S, 1, j);
+      const double sw = at(S, i, 0) * at(W, 0, j) + at(S, i, 1) * at(W, 1, j);
+      r.v[i + 3 * j] = at(S, i, j) + dt * ((two_G * at(D, i, j) + ws) - sw);
+    }
+  }
+  r.v[2] = 0.0;
+  r.v[5] = 0.0;
+  r.v[6] = 0.0;
+  r.v[7] = 0.0;
+  r.v[8] = S.v[8] + dt * (two_G * D.v[8]);
+  const double trD = D.v[0] + (D.v[4] + D.v[8]);
+  const double vol = dt * (K - two_G / 3.0) * trD;
+  r.v[0] += vol;
+  r.v[4] += vol;
+  r.v[8] += vol;
+}
+
 /// The E16 trial of one point: s = the deviator of the trial stress, p_tr = -tr/3 and
 /// tau_tr = sqrt(|dev|^2/2). (Results through references: a returned T9 is copied as an aggregate
 /// in the portable build, which stops the vectorisation.) The sums in the order of Eigen's trace() (d00 + (d11 + d22)) and
@@ -148,6 +178,23 @@ inline void elastic_trial(const T9& S, const T9& D, const T9& W, double dt, doub
   double q[9];
   for (int k = 0; k < 9; ++k) q[k] = s.v[k] * s.v[k];
   const double sq = (((q[0] + q[2]) + (q[4] + q[6])) + ((q[1] + q[3]) + (q[5] + q[7]))) + q[8];
+  tau_tr = std::sqrt(0.5 * sq);
+}
+
+/// elastic_trial for a point in plane motion (jaumann_trial_plane): |s|^2 without the four zero
+/// squares, whose sums with them were exact.
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void elastic_trial_plane(const T9& S, const T9& D, const T9& W, double dt, double G, double K, T9& s,
+                                double& p_tr, double& tau_tr) {
+  jaumann_trial_plane(S, D, W, dt, G, K, s);
+  p_tr = -(s.v[0] + (s.v[4] + s.v[8])) / 3.0;
+  s.v[0] += p_tr;
+  s.v[4] += p_tr;
+  s.v[8] += p_tr;
+  const double q0 = s.v[0] * s.v[0], q1 = s.v[1] * s.v[1], q3 = s.v[3] * s.v[3], q4 = s.v[4] * s.v[4];
+  const double sq = ((q0 + q4) + (q1 + q3)) + s.v[8] * s.v[8];
   tau_tr = std::sqrt(0.5 * sq);
 }
 
@@ -971,26 +1018,66 @@ inline void gather_components(const Eigen::Matrix3d* mats, int m, double (*out)[
     for (int q = 0; q < 9; ++q) out[q][i] = mats[i].data()[q];
 }
 
-/// (1) The E16 trials (begin(): checks, trial, f_m) of the block's points.
+/// The entries xx, yx, xy, yy, zz (T9 indices 0, 1, 3, 4, 8) of m matrices into rows out[q][i] of
+/// those indices (the others are not written), as gather_components.
+inline void gather_plane_components(const Eigen::Matrix3d* mats, int m, double (*out)[BatchBlock::kSize]) {
+  int i = 0;
+#if defined(__SSE2__)
+  for (; i + 1 < m; i += 2) {
+    const double* a = mats[i].data();
+    const double* c = mats[i + 1].data();
+    const __m128d A0 = _mm_loadu_pd(a), C0 = _mm_loadu_pd(c), A3 = _mm_loadu_pd(a + 3), C3 = _mm_loadu_pd(c + 3);
+    _mm_storeu_pd(&out[0][i], _mm_unpacklo_pd(A0, C0));
+    _mm_storeu_pd(&out[1][i], _mm_unpackhi_pd(A0, C0));
+    _mm_storeu_pd(&out[3][i], _mm_unpacklo_pd(A3, C3));
+    _mm_storeu_pd(&out[4][i], _mm_unpackhi_pd(A3, C3));
+    _mm_storeu_pd(&out[8][i], _mm_set_pd(c[8], a[8]));
+  }
+#endif
+  for (; i < m; ++i) {
+    const double* a = mats[i].data();
+    out[0][i] = a[0], out[1][i] = a[1], out[3][i] = a[3], out[4][i] = a[4], out[8][i] = a[8];
+  }
+}
+
+/// (1) The E16 trials (begin(): checks, trial, f_m) of the block's points. `Plane`: sigma and L
+/// have zero xz, yz, zx, zy entries (advance_batch's `in_plane`), and the trials read and form
+/// only the other five (elastic_trial_plane; the same values).
+template <bool Plane>
 [[gnu::noinline]] void batch_trials(const BatchConsts& k, BatchBlock& b, int m, const Eigen::Matrix3d* sigma,
                                     const Eigen::Matrix3d* L, const double* f, const double* phi) {
-  gather_components(sigma, m, b.bS);
-  gather_components(L, m, b.bL);
+  if constexpr (Plane) {
+    gather_plane_components(sigma, m, b.bS);
+    gather_plane_components(L, m, b.bL);
+  } else {
+    gather_components(sigma, m, b.bS);
+    gather_components(L, m, b.bL);
+  }
   const double dt = k.dt, G = k.G, K = k.K;
   const bool step_ok = k.step_ok;
 #pragma omp simd
   for (int i = 0; i < m; ++i) {
-    T9 Sx, Dx, Wx;
+    T9 Sx, Dx, Wx, sx;
     double pt, tt;
-    for (int q = 0; q < 9; ++q) Sx.v[q] = b.bS[q][i];
-    for (int jj = 0; jj < 3; ++jj) {
-      for (int ii = 0; ii < 3; ++ii) {
-        Dx.v[ii + 3 * jj] = 0.5 * (b.bL[ii + 3 * jj][i] + b.bL[jj + 3 * ii][i]);
-        Wx.v[ii + 3 * jj] = 0.5 * (b.bL[ii + 3 * jj][i] - b.bL[jj + 3 * ii][i]);
+    if constexpr (Plane) {
+      Sx.v[0] = b.bS[0][i], Sx.v[1] = b.bS[1][i], Sx.v[2] = 0.0, Sx.v[3] = b.bS[3][i], Sx.v[4] = b.bS[4][i];
+      Sx.v[5] = 0.0, Sx.v[6] = 0.0, Sx.v[7] = 0.0, Sx.v[8] = b.bS[8][i];
+      const double l0 = b.bL[0][i], l1 = b.bL[1][i], l3 = b.bL[3][i], l4 = b.bL[4][i], l8 = b.bL[8][i];
+      Dx.v[0] = 0.5 * (l0 + l0), Dx.v[1] = 0.5 * (l1 + l3), Dx.v[2] = 0.0, Dx.v[3] = 0.5 * (l3 + l1);
+      Dx.v[4] = 0.5 * (l4 + l4), Dx.v[5] = 0.0, Dx.v[6] = 0.0, Dx.v[7] = 0.0, Dx.v[8] = 0.5 * (l8 + l8);
+      Wx.v[0] = 0.0, Wx.v[1] = 0.5 * (l1 - l3), Wx.v[2] = 0.0, Wx.v[3] = 0.5 * (l3 - l1), Wx.v[4] = 0.0;
+      Wx.v[5] = 0.0, Wx.v[6] = 0.0, Wx.v[7] = 0.0, Wx.v[8] = 0.0;
+      elastic_trial_plane(Sx, Dx, Wx, dt, G, K, sx, pt, tt);
+    } else {
+      for (int q = 0; q < 9; ++q) Sx.v[q] = b.bS[q][i];
+      for (int jj = 0; jj < 3; ++jj) {
+        for (int ii = 0; ii < 3; ++ii) {
+          Dx.v[ii + 3 * jj] = 0.5 * (b.bL[ii + 3 * jj][i] + b.bL[jj + 3 * ii][i]);
+          Wx.v[ii + 3 * jj] = 0.5 * (b.bL[ii + 3 * jj][i] - b.bL[jj + 3 * ii][i]);
+        }
       }
+      elastic_trial(Sx, Dx, Wx, dt, G, K, sx, pt, tt);
     }
-    T9 sx;
-    elastic_trial(Sx, Dx, Wx, dt, G, K, sx, pt, tt);
     const double ff = f[i], ph = phi[i];
     const bool ok = step_ok & point_inputs_valid(ph, ff, Sx, Dx, Wx);  // as begin()
     for (int q = 0; q < 9; ++q) b.t_s[q][i] = sx.v[q];
@@ -1172,7 +1259,7 @@ template <int N>
 }  // namespace
 
 void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* f, const Eigen::Matrix3d* L,
-                                const double* phi, double dt, GranularStep* step) const {
+                                const double* phi, double dt, GranularStep* step, bool in_plane) const {
   // Blocks of points: (1) the trials in lanes; (2) return_map up to its Newton solves in lanes:
   // the branches, the closed forms' results (elastic, f_1 + f_3, separated) in the block's r_*
   // arrays, and the solves as lists of points (the f_1-only branch; the p_tr <= 0 fast path);
@@ -1202,7 +1289,8 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
     const int m = static_cast<int>(std::min<std::int64_t>(kBlock, n - b0));
     int f1_point[kBlock], tj_point[kBlock];
     // ---- (1) trials ----
-    batch_trials(kc, b, m, sigma + b0, L + b0, f + b0, phi + b0);
+    if (in_plane) batch_trials<true>(kc, b, m, sigma + b0, L + b0, f + b0, phi + b0);
+    else batch_trials<false>(kc, b, m, sigma + b0, L + b0, f + b0, phi + b0);
     // E8 on its own, in blocks with the powers in vector lanes (inside begin() they serialised
     // with the trial); lanes of invalid points (and past m) get a stand-in phi and then 0
     static_assert(kBlock % numerics::kMathBlock == 0);

@@ -130,8 +130,13 @@ class GranularLaw {
   /// own is done) and the end of step; return_map() and finish() themselves only where a lane
   /// solve fails or a point needs the implicit structure update or the forced f = 1
   /// (docs/granular.md). n may be any size.
+  ///
+  /// `in_plane`: the caller guarantees that the xz, yz, zx and zy entries of every sigma[i] and
+  /// L[i] are zero (plane strain; zz may be anything). The trials then read and form only the
+  /// other five entries: the same results (a zero entry of the stress may come out +0 where the
+  /// general trials give -0).
   void advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* f, const Eigen::Matrix3d* L, const double* phi,
-                     double dt, GranularStep* step) const;
+                     double dt, GranularStep* step, bool in_plane = false) const;
   static constexpr int kLanes = 8;
 
   /// Throws NumericalError with describe() unless u.ok().

@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cassert>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 #include <fmt/format.h>
@@ -37,6 +39,11 @@ class GranularBodyLaw final : public StressLaw<G> {
     return std::clamp(body.mass_kg[q] / (rho_s_ * body.volume_m3[q]), 1e-9, 1.0 - 1e-9);
   }
 
+  /// Plane strain: L has no out-of-plane shear (PlaneStrain::write_velocity_gradient), and the law
+  /// never creates xz, yz stresses from zero ones, so the law's in-plane trials apply
+  /// (advance_batch's in_plane: the same results, 9% less time for the law on the wheel's bed).
+  static constexpr bool kInPlane = std::is_same_v<G, PlaneStrain>;
+
   void update_stress(Body<G>& body, double dt_s) override {
     const std::int64_t np = body.size();
     std::int64_t first_bad = std::numeric_limits<std::int64_t>::max();
@@ -53,7 +60,14 @@ class GranularBodyLaw final : public StressLaw<G> {
       double phi[kChunk];
       material::GranularStep step[kChunk];
       for (std::int64_t i = 0; i < m; ++i) phi[i] = phi_of(body, q0 + i);
-      law_.advance_batch(m, body.stress_Pa.data() + q0, f.data() + q0, body.L_1_s.data() + q0, phi, dt_s, step);
+#ifndef NDEBUG
+      if constexpr (kInPlane)
+        for (std::int64_t i = 0; i < m; ++i)
+          for (int e : {2, 5, 6, 7})
+            assert(body.stress_Pa[q0 + i].data()[e] == 0.0 && body.L_1_s[q0 + i].data()[e] == 0.0);
+#endif
+      law_.advance_batch(m, body.stress_Pa.data() + q0, f.data() + q0, body.L_1_s.data() + q0, phi, dt_s, step,
+                         kInPlane);
       for (std::int64_t i = 0; i < m; ++i) {
         if (!step[i].ok) {
           first_bad = std::min(first_bad, q0 + i);
