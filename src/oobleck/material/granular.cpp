@@ -1040,6 +1040,19 @@ inline void gather_plane_components(const Eigen::Matrix3d* mats, int m, double (
   }
 }
 
+/// Whether the m matrices sigma and L all have zero xz, yz, zx, zy entries (an axisymmetric flow
+/// without swirl, plane strain): stops at the first one that does not.
+inline bool block_in_plane(const Eigen::Matrix3d* sigma, const Eigen::Matrix3d* L, int m) {
+  for (int i = 0; i < m; ++i) {
+    const double* s = sigma[i].data();
+    const double* l = L[i].data();
+    const bool zero = (s[2] == 0.0) & (s[5] == 0.0) & (s[6] == 0.0) & (s[7] == 0.0) & (l[2] == 0.0) &
+                      (l[5] == 0.0) & (l[6] == 0.0) & (l[7] == 0.0);
+    if (!zero) return false;
+  }
+  return true;
+}
+
 /// (1) The E16 trials (begin(): checks, trial, f_m) of the block's points. `Plane`: sigma and L
 /// have zero xz, yz, zx, zy entries (advance_batch's `in_plane`), and the trials read and form
 /// only the other five (elastic_trial_plane; the same values).
@@ -1289,7 +1302,8 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
     const int m = static_cast<int>(std::min<std::int64_t>(kBlock, n - b0));
     int f1_point[kBlock], tj_point[kBlock];
     // ---- (1) trials ----
-    if (in_plane) batch_trials<true>(kc, b, m, sigma + b0, L + b0, f + b0, phi + b0);
+    // (the in-plane trials also for blocks whose points all happen to be in plane motion)
+    if (in_plane || block_in_plane(sigma + b0, L + b0, m)) batch_trials<true>(kc, b, m, sigma + b0, L + b0, f + b0, phi + b0);
     else batch_trials<false>(kc, b, m, sigma + b0, L + b0, f + b0, phi + b0);
     // E8 on its own, in blocks with the powers in vector lanes (inside begin() they serialised
     // with the trial); lanes of invalid points (and past m) get a stand-in phi and then 0
