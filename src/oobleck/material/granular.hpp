@@ -134,7 +134,8 @@ class GranularLaw {
   /// `in_plane`: the caller guarantees that the xz, yz, zx and zy entries of every sigma[i] and
   /// L[i] are zero (plane strain; zz may be anything). The trials then read and form only the
   /// other five entries: the same results (a zero entry of the stress may come out +0 where the
-  /// general trials give -0).
+  /// general trials give -0). Without it, each block of 128 points whose entries are all zero
+  /// (an axisymmetric flow without swirl) is found and takes the same trials.
   void advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* f, const Eigen::Matrix3d* L, const double* phi,
                      double dt, GranularStep* step, bool in_plane = false) const;
   static constexpr int kLanes = 8;

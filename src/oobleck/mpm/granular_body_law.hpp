@@ -5,9 +5,9 @@
 // fails (non-convergence, non-finite input) stops the run with a diagnosis naming the point, the
 // law, its state and inputs (NumericalError), never a silent NaN.
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstdint>
-#include <cassert>
 #include <limits>
 #include <type_traits>
 #include <vector>
