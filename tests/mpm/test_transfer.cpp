@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "oobleck/mpm/transfer.hpp"
@@ -277,4 +278,130 @@ TEST(Transfer, GravityInP2GEqualsTheSeparatePassOnOneAndTwoThreads) {
     check_gravity_in_p2g<PlaneStrain>(threads);
     check_gravity_in_p2g<Axisymmetric>(threads);
   }
+}
+
+// Axisymmetric beds without swirl: P2G leaves out the θ terms of points with zero θ entries of v,
+// C, σ and f_ext, and G2P the θ sums when no node has a θ velocity or flux. Both give the general
+// kernels' values bit for bit (the θ results stay +0), here on a body that mixes points with and
+// without swirl.
+namespace {
+void zero_swirl(Body<Axisymmetric>& b, std::int64_t p) {
+  b.v_m_s[p][2] = 0.0;
+  b.C_1_s[p].row(2).setZero();
+  b.f_ext_N[p][2] = 0.0;
+  Mat3& s = b.stress_Pa[p];
+  s(0, 2) = s(2, 0) = s(1, 2) = s(2, 1) = 0.0;
+}
+}  // namespace
+
+TEST(Transfer, AxisymmetricWithoutSwirlEqualsTheGeneralKernelsBitForBit) {
+  using G = Axisymmetric;
+  constexpr int NC = G::ncomp, K = 9;
+  ::Setup<G> st(33u);
+  auto& b = st.body;
+  std::int64_t without = 0;
+  for (std::int64_t p = 0; p < b.size(); ++p)
+    if (p % 3 != 0) zero_swirl(b, p);
+  for (std::int64_t p = 0; p < b.size(); ++p) without += detail::point_without_swirl(b, p) ? 1 : 0;
+  ASSERT_EQ(without, b.size() - (b.size() + 2) / 3);
+  const int nn = st.grid.node_count();
+  const QuadraticBSplineKernel kernel{};
+  for (bool apic : {true, false})
+    for (bool split : {true, false}) {
+      SCOPED_TRACE(::testing::Message() << "apic " << apic << " split " << split);
+      GridField<G> field;
+      field.resize(nn, 1);
+      ShapeCache<2> cache;
+      ASSERT_EQ((particles_to_grid<G, K>(b, st.grid, kernel, cache, field, apic, split)), 0);
+      std::vector<double> m(nn, 0.0), vol(nn, 0.0);
+      std::vector<Vec<NC>> mv(nn, Vec<NC>::Zero()), f(nn, Vec<NC>::Zero()), fp(nn, Vec<NC>::Zero());
+      for (std::int64_t p = 0; p < b.size(); ++p) {
+        auto general = [&]<bool A, bool Sp>() {
+          detail::particles_to_grid_point<G, K, A, Sp, false>(b, cache, p, m.data(), mv.data()->data(),
+                                                              f.data()->data(), fp.data()->data(), vol.data());
+        };
+        if (apic && split) general.operator()<true, true>();
+        if (apic && !split) general.operator()<true, false>();
+        if (!apic && split) general.operator()<false, true>();
+        if (!apic && !split) general.operator()<false, false>();
+      }
+      for (int i = 0; i < nn; ++i) {
+        ASSERT_EQ(field.mass_kg[i], m[i]);
+        for (int c = 0; c < NC; ++c) {
+          ASSERT_EQ(field.momentum[i][c], mv[i][c]) << "node " << i << " c " << c;
+          ASSERT_EQ(field.force_N[i][c], f[i][c]) << "node " << i << " c " << c;
+          if (split) {
+            ASSERT_EQ(field.pressure_force_N[i][c], fp[i][c]) << "node " << i << " c " << c;
+            ASSERT_FALSE(std::signbit(field.pressure_force_N[i][c]) != std::signbit(fp[i][c]));
+          }
+          ASSERT_FALSE(std::signbit(field.momentum[i][c]) != std::signbit(mv[i][c]));
+          ASSERT_FALSE(std::signbit(field.force_N[i][c]) != std::signbit(f[i][c]));
+        }
+        if (split) {
+          ASSERT_EQ(field.volume_m3[i], vol[i]);
+        }
+      }
+    }
+  // G2P on nodes without θ velocity (new and old) and θ flux, of either sign of zero.
+  GridField<G> field;
+  field.resize(nn, 1);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> s(-1.0, 1.0);
+  std::vector<double> porosity(nn);
+  std::vector<Vec<NC>> flux(nn);
+  for (int i = 0; i < nn; ++i) {
+    const double zero = i % 2 == 0 ? 0.0 : -0.0;
+    field.velocity[i] = Vec<NC>(s(rng), s(rng), zero);
+    field.velocity_old[i] = Vec<NC>(s(rng), s(rng), -zero);
+    flux[i] = Vec<NC>(s(rng), s(rng), zero);
+    porosity[i] = 0.5 + 0.1 * s(rng);
+  }
+  b.phi.assign(b.x_m.size(), 0.0);
+  b.div_q_1_s.assign(b.x_m.size(), 0.0);
+  ShapeCache<2> cache;
+  ASSERT_EQ(compute_shape_cache(st.grid, kernel, b.x_m, cache), 0);
+  for (Transfer t : {Transfer::Apic, Transfer::FlipPicBlend})
+    for (bool mix : {true, false}) {
+      SCOPED_TRACE(::testing::Message() << "apic " << (t == Transfer::Apic) << " mixture " << mix);
+      ::Setup<G> s1(33u), s2(33u);  // (bodies are not copyable: the same points twice)
+      Body<G>&b1 = s1.body, &b2 = s2.body;
+      for (Body<G>* x : {&b1, &b2}) {
+        for (std::int64_t p = 0; p < x->size(); ++p)
+          if (p % 3 != 0) zero_swirl(*x, p);
+        x->phi.assign(x->x_m.size(), 0.0);
+        x->div_q_1_s.assign(x->x_m.size(), 0.0);
+      }
+      const double* n = mix ? porosity.data() : nullptr;
+      const Vec<NC>* q = mix ? flux.data() : nullptr;
+      // Both kernels compiled here (the library's own instance may be built for another CPU level,
+      // with other contractions).
+      auto both = [&]<bool A, bool Mix>() {
+        const std::int64_t r1 =
+            detail::grid_to_particles_kernel<G, K, A, false, Mix, true>(b1, cache, field, st.grid, 0.95, 1e-3, n, q);
+        const std::int64_t r2 =
+            detail::grid_to_particles_kernel<G, K, A, false, Mix, false>(b2, cache, field, st.grid, 0.95, 1e-3, n, q);
+        return std::min(r1, r2);  // (kAllFinite only if both are)
+      };
+      std::int64_t bad = 0;
+      if (t == Transfer::Apic && mix) bad = both.operator()<true, true>();
+      if (t == Transfer::Apic && !mix) bad = both.operator()<true, false>();
+      if (t != Transfer::Apic && mix) bad = both.operator()<false, true>();
+      if (t != Transfer::Apic && !mix) bad = both.operator()<false, false>();
+      ASSERT_EQ(bad, kAllFinite);
+      auto same = [](const double* x, const double* y, std::size_t count) {
+        for (std::size_t k = 0; k < count; ++k)
+          if (std::memcmp(x + k, y + k, sizeof(double)) != 0) return false;
+        return true;
+      };
+      const auto np = static_cast<std::size_t>(b.size());
+      EXPECT_TRUE(same(b1.x_m.data()->data(), b2.x_m.data()->data(), 2 * np));
+      EXPECT_TRUE(same(b1.v_m_s.data()->data(), b2.v_m_s.data()->data(), NC * np));
+      EXPECT_TRUE(same(b1.C_1_s.data()->data(), b2.C_1_s.data()->data(), 2 * NC * np));
+      EXPECT_TRUE(same(b1.L_1_s.data()->data(), b2.L_1_s.data()->data(), 9 * np));
+      EXPECT_TRUE(same(b1.volume_m3.data(), b2.volume_m3.data(), np));
+      if (mix) {
+        EXPECT_TRUE(same(b1.phi.data(), b2.phi.data(), np));
+        EXPECT_TRUE(same(b1.div_q_1_s.data(), b2.div_q_1_s.data(), np));
+      }
+    }
 }

@@ -95,10 +95,16 @@ struct SecondAxisFactors {
 /// split-pressure branches resolved at compile time and scalar per-point temporaries (no
 /// stack round trips of Eigen 3-vectors in the node loop). Arithmetic order per component is that
 /// of the Eigen expressions it replaces.
-template <class G, int K, bool Apic, bool Split>
+///
+/// NoSwirl (axisymmetric only, see point_without_swirl): the point's θ entries of v, C, σ and f_ext
+/// are zero, so all its θ terms on the nodes are zeros (of either sign) and adding them to the
+/// nodal sums (which start at +0) changes no bit: they are left out.
+template <class G, int K, bool Apic, bool Split, bool NoSwirl = false>
 inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim>& cache, std::int64_t p,
                                     double* m, double* mv, double* f, double* fp, double* vol) {
   constexpr int D = G::dim, NC = G::ncomp, S = support_of<D>(K);
+  static_assert(!NoSwirl || G::has_hoop_terms);
+  constexpr bool kTheta = NC == 3 && !NoSwirl;  // the third component's nodal terms
   {
     const double mp = body.mass_kg[p], Vp = body.volume_m3[p];
     const Vec<NC> vp = body.v_m_s[p];
@@ -176,7 +182,7 @@ inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim
           if constexpr (Apic) mvi2 += a1.w[j1].cwiseProduct(U2) + a1.wo[j1].cwiseProduct(Vc2);
           else mvi2 += a1.w[j1].cwiseProduct(U2);
           fi2 += a1.w[j1].cwiseProduct(E2) + a1.dw[j1].cwiseProduct(nB2);
-          if constexpr (NC == 3) {
+          if constexpr (kTheta) {
             if constexpr (Apic) mvi[2] += w1 * U3 + (w1 * st.off[j1][1]) * Vc3;
             else mvi[2] += w1 * U3;
             fi[2] += w1 * E3 + dw1 * nB3;
@@ -185,7 +191,7 @@ inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim
             double* fpi = fp + static_cast<std::int64_t>(i) * NC;
             Eigen::Map<V2>(fpi) += PV2.cwiseProduct(a1.w_dw[j1]);  // V_p p (N'_0 N_1, N_0 N'_1)
             if constexpr (G::has_hoop_terms)
-              for (int c = 0; c < NC; ++c) fpi[c] += w1 * (w0 * fppt[c]);
+              fpi[0] += w1 * (w0 * fppt[0]);  // (its z and θ entries are zeros: left out)
             vol[i] += (w0 * Vp) * w1;
           }
         }
@@ -233,6 +239,17 @@ inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim
       }
     });
   }
+}
+
+/// Axisymmetric: whether point p has no swirl, i.e. zero θ entries of v, of C's θ row, of σ's
+/// (θ,r), (θ,z), (r,θ) and of f_ext. Then its hoop θ force and Coriolis term are zeros as well, and
+/// P2G may leave out all its θ terms (particles_to_grid_point's NoSwirl). Branch-free test.
+template <class G>
+inline bool point_without_swirl(const Body<G>& body, std::int64_t p) {
+  const Mat3& s = body.stress_Pa[p];
+  const auto& C = body.C_1_s[p];
+  return static_cast<bool>((body.v_m_s[p][2] == 0.0) & (C(2, 0) == 0.0) & (C(2, 1) == 0.0) & (s(2, 0) == 0.0) &
+                           (s(2, 1) == 0.0) & (s(0, 2) == 0.0) & (body.f_ext_N[p][2] == 0.0));
 }
 
 }  // namespace detail
@@ -299,6 +316,13 @@ std::int64_t particles_to_grid(const Body<G>& body, const Grid<G::dim>& grid, co
 #pragma omp for schedule(static) reduction(+ : bad)
       for (std::int64_t p = 0; p < np; ++p) {
         if (!make_stencil(grid, sg, kernel, body.x_m[p], cache.template stencil<S>(p), cache.inv_D[p])) ++bad;
+        if constexpr (G::has_hoop_terms) {
+          // Beds without swirl (the intruder, the rod) skip the θ terms: the same sums.
+          if (detail::point_without_swirl(body, p)) {
+            detail::particles_to_grid_point<G, K, A, Sp, true>(body, cache, p, m, mvd, fd, fpd, vol);
+            continue;
+          }
+        }
         detail::particles_to_grid_point<G, K, A, Sp>(body, cache, p, m, mvd, fd, fpd, vol);
       }
     };
@@ -356,11 +380,17 @@ namespace detail {
 /// APIC by gradient, mixture fields). Plain scalar accumulators: the Eigen fixed-size 3-vectors of
 /// the axisymmetric mode went through the stack with partial stores and wide reloads (store
 /// forwarding stalls); the arithmetic and its order per component are unchanged.
-template <class G, int K, bool Apic, bool ByGrad, bool Mixture>
+///
+/// NoSwirl (axisymmetric only): the body's nodal θ velocities (new and old) and, for the mixture,
+/// the θ flux are all zero, so every θ sum over the nodes is +0 (they start at +0): the sums are
+/// left out and stay +0, the same values.
+template <class G, int K, bool Apic, bool ByGrad, bool Mixture, bool NoSwirl = false>
 std::int64_t grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& cache, const GridField<G>& field,
                               const Grid<G::dim>& grid, double alpha, double dt_s, const double* porosity,
                               const Vec<G::ncomp>* mixture_flux) {
   constexpr int D = G::dim, NC = G::ncomp, S = support_of<D>(K);
+  static_assert(!NoSwirl || G::has_hoop_terms);
+  constexpr bool kTheta = NC == 3 && !NoSwirl;  // the third component's sums over the nodes
   const std::int64_t np = body.size();
   const double* const inv_D = cache.inv_D.data()->data();
   const double* const vel = field.velocity.data()->data();
@@ -416,31 +446,31 @@ std::int64_t grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& c
             const V2 vi2 = Eigen::Map<const V2>(vi);
             t2 += a1.w[j1].cwiseProduct(vi2);
             tg2 += a1.dw[j1].cwiseProduct(vi2);
-            if constexpr (NC == 3) {
+            if constexpr (kTheta) {
               t3 += w1 * vi[2];
               tg3 += dw1 * vi[2];
             }
             if constexpr (Apic && !ByGrad) {
               to2 += a1.wo[j1].cwiseProduct(vi2);
-              if constexpr (NC == 3) to3 += (w1 * st.off[j1][1]) * vi[2];
+              if constexpr (kTheta) to3 += (w1 * st.off[j1][1]) * vi[2];
             }
             if constexpr (!Apic) {
               const double* vo = vel_old + static_cast<std::int64_t>(i) * NC;
               td2 += a1.w[j1].cwiseProduct(vi2 - Eigen::Map<const V2>(vo));
-              if constexpr (NC == 3) td3 += w1 * (vi[2] - vo[2]);
+              if constexpr (kTheta) td3 += w1 * (vi[2] - vo[2]);
             }
             if constexpr (Mixture) {
               const double* qi = flux + static_cast<std::int64_t>(i) * NC;
               tn += w1 * porosity[i];
               tq2 += a1.w[j1].cwiseProduct(Eigen::Map<const V2>(qi));
               tqy += dw1 * qi[1];
-              if constexpr (G::has_hoop_terms) tq3 += w1 * qi[2];
+              if constexpr (kTheta) tq3 += w1 * qi[2];
             }
           }
           vp2 += w0 * t2;
           gv2[0] += dw0 * t2;
           gv2[1] += w0 * tg2;
-          if constexpr (NC == 3) {
+          if constexpr (kTheta) {
             vp3 += w0 * t3;
             gv3[0] += dw0 * t3;
             gv3[1] += w0 * tg3;
@@ -448,21 +478,21 @@ std::int64_t grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& c
           if constexpr (Apic && !ByGrad) {
             B2[0] += (w0 * o0) * t2;
             B2[1] += w0 * to2;
-            if constexpr (NC == 3) {
+            if constexpr (kTheta) {
               B3[0] += (w0 * o0) * t3;
               B3[1] += w0 * to3;
             }
           }
           if constexpr (!Apic) {
             dv2 += w0 * td2;
-            if constexpr (NC == 3) dv3 += w0 * td3;
+            if constexpr (kTheta) dv3 += w0 * td3;
           }
           if constexpr (Mixture) {
             n_p += w0 * tn;
             div_q += dw0 * tq2[0] + w0 * tqy;
             if constexpr (G::has_hoop_terms) {
               q2 += w0 * tq2;
-              q3 += w0 * tq3;
+              if constexpr (kTheta) q3 += w0 * tq3;
             }
           }
           (void)o0;
@@ -647,12 +677,26 @@ std::int64_t grid_to_particles(Body<G>& body, const ShapeCache<G::dim>& cache, c
                                const Grid<G::dim>& grid, Transfer transfer, double flip_fraction, double dt_s,
                                const double* porosity = nullptr, const Vec<G::ncomp>* mixture_flux = nullptr) {
   const bool mix = porosity != nullptr;
+  bool no_swirl = false;
+  if constexpr (G::has_hoop_terms) {
+    // No θ velocity on any node (and no θ flux): the NoSwirl kernels (the same values).
+    const int nn = field.nodes();
+    no_swirl = true;
+    for (int i = 0; i < nn; ++i)
+      no_swirl &= (field.velocity[i][2] == 0.0) & (field.velocity_old[i][2] == 0.0) &
+                  (!mix || mixture_flux[i][2] == 0.0);
+  }
   auto run = [&]<bool A, bool BG>() {
-    if (mix)
-      return detail::grid_to_particles_kernel<G, K, A, BG, true>(body, cache, field, grid, flip_fraction, dt_s,
-                                                                 porosity, mixture_flux);
-    return detail::grid_to_particles_kernel<G, K, A, BG, false>(body, cache, field, grid, flip_fraction, dt_s,
-                                                                nullptr, nullptr);
+    auto kernel = [&]<bool NS>() {
+      if (mix)
+        return detail::grid_to_particles_kernel<G, K, A, BG, true, NS>(body, cache, field, grid, flip_fraction, dt_s,
+                                                                       porosity, mixture_flux);
+      return detail::grid_to_particles_kernel<G, K, A, BG, false, NS>(body, cache, field, grid, flip_fraction, dt_s,
+                                                                      nullptr, nullptr);
+    };
+    if constexpr (G::has_hoop_terms)
+      if (no_swirl) return kernel.template operator()<true>();
+    return kernel.template operator()<false>();
   };
   if (transfer != Transfer::Apic) return run.template operator()<false, false>();
   if (cache.apic_by_gradient) return run.template operator()<true, true>();
