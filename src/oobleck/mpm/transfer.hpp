@@ -9,6 +9,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -243,13 +244,16 @@ inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim
 
 /// Axisymmetric: whether point p has no swirl, i.e. zero θ entries of v, of C's θ row, of σ's
 /// (θ,r), (θ,z), (r,θ) and of f_ext. Then its hoop θ force and Coriolis term are zeros as well, and
-/// P2G may leave out all its θ terms (particles_to_grid_point's NoSwirl). Branch-free test.
+/// P2G may leave out all its θ terms (particles_to_grid_point's NoSwirl).
 template <class G>
 inline bool point_without_swirl(const Body<G>& body, std::int64_t p) {
+  // (the bits of the seven values but their signs: zero only if each is ±0; a NaN is not zero)
   const Mat3& s = body.stress_Pa[p];
   const auto& C = body.C_1_s[p];
-  return static_cast<bool>((body.v_m_s[p][2] == 0.0) & (C(2, 0) == 0.0) & (C(2, 1) == 0.0) & (s(2, 0) == 0.0) &
-                           (s(2, 1) == 0.0) & (s(0, 2) == 0.0) & (body.f_ext_N[p][2] == 0.0));
+  auto bits = [](double x) { return std::bit_cast<std::uint64_t>(x); };
+  const std::uint64_t any = bits(body.v_m_s[p][2]) | bits(C(2, 0)) | bits(C(2, 1)) | bits(s(2, 0)) |
+                            bits(s(2, 1)) | bits(s(0, 2)) | bits(body.f_ext_N[p][2]);
+  return (any << 1) == 0;
 }
 
 }  // namespace detail
