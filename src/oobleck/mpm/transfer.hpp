@@ -249,6 +249,8 @@ inline void particles_to_grid_point_inlined(const Body<G>& body, const ShapeCach
   }
 }
 
+/// particles_to_grid_point_inlined behind a call that GCC may or may not inline (the
+/// axisymmetric kernels' P2G; the tests' reference).
 template <class G, int K, bool Apic, bool Split, bool NoSwirl = false>
 inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim>& cache, std::int64_t p,
                                     double* m, double* mv, double* f, double* fp, double* vol) {
@@ -340,6 +342,7 @@ std::int64_t particles_to_grid(const Body<G>& body, const Grid<G::dim>& grid, co
             continue;
           }
         }
+        // (axisymmetric with swirl: the general kernel; plane strain and 3D: inlined here)
         if constexpr (G::has_hoop_terms) detail::particles_to_grid_point<G, K, A, Sp>(body, cache, p, m, mvd, fd, fpd, vol);
         else detail::particles_to_grid_point_inlined<G, K, A, Sp>(body, cache, p, m, mvd, fd, fpd, vol);
       }
