@@ -402,7 +402,7 @@ Floating float_rod() {
   fill_box(fluid, Vec<2>(0.0, 0.0), Vec<2>(Rc, D), h, 2, rho_f, [](const Vec<2>&) { return Vec<3>::Zero(); });
   for (std::int64_t p = 0; p < fluid.size(); ++p) {  // hydrostatic start: p = ρ g (D − z)
     const double pr = rho_f * g * (D - fluid.x_m[p][1]);
-    fl->J[p] = std::exp(-pr / fp.kappa_Pa);
+    fl->ln_J[p] = -pr / fp.kappa_Pa;
     fluid.stress_Pa[p] = -pr * Mat3::Identity();
   }
   auto& rod = s.add_body("rod");

@@ -69,8 +69,8 @@ TEST(TerzaghiV5, PorePressureMatchesSeriesSolution) {
   for (std::int64_t p = 0; p < grains.size(); ++p)
     if (grains.x_m[p][1] > H - h / 2) grains.f_ext_N[p] = Vec<2>(0.0, -q * h / 2);
   for (std::int64_t p = 0; p < fluid.size(); ++p) {
-    law->J[p] = std::exp(-q / kappa);
-    fluid.mass_kg[p] /= law->J[p];
+    law->ln_J[p] = -q / kappa;
+    fluid.mass_kg[p] /= std::exp(law->ln_J[p]);
     fluid.stress_Pa[p].diagonal().setConstant(-q);
     fluid.phi[p] = phi;
   }

@@ -4,7 +4,10 @@
 //
 //   E25  τ_f = η_0 (1 + (5/2) φ) (∇v_f + ∇v_fᵀ − (2/3) div v_f 1)   (Einstein-corrected viscosity)
 //   E26  p_f = κ ln(ρ_f/ρ_f0) = −κ ln J,   J = ρ_f0/ρ_f
-//   E27  (n/ρ_f) Dρ_f/Dt = −div q,  q = (1−n) v_s + n v_f  ⇒  J ← J exp(Δt div q / n)
+//   E27  (n/ρ_f) Dρ_f/Dt = −div q,  q = (1−n) v_s + n v_f  ⇒  J ← J exp(Δt div q / n),
+//        in logarithms ln J ← ln J + Δt div q / n (the form the MPM solver integrates: E26 needs
+//        only ln J, so no exp and log per point and step, and ln J keeps its relative precision
+//        where J is within 1e-3 of 1)
 //
 // Stress is positive in tension; p_f is positive in compression. Tensors are 3×3 in every
 // geometry mode (plane strain: zero third row/column of L; axisymmetric: (r, z, θ) order).
@@ -48,6 +51,15 @@ inline double fluid_pressure_from_density(double rho_f, double rho_f0, double ka
 /// `porosity` n must be > 0 (the solver clamps it with a named minimum, model.md §5).
 inline double update_fluid_volume_ratio(double J, double div_q_per_s, double porosity, double dt_s) {
   return J * std::exp(dt_s * div_q_per_s / porosity);
+}
+
+/// E26 from the logarithmic volume ratio: p_f = −κ ln J [Pa].
+inline double fluid_pressure_from_log_volume_ratio(double ln_J, double kappa_Pa) { return -kappa_Pa * ln_J; }
+
+/// E27 in logarithms, the same integration as update_fluid_volume_ratio (div q and n frozen over
+/// the step): ln J ← ln J + Δt div q / n. `porosity` n must be > 0.
+inline double update_fluid_log_volume_ratio(double ln_J, double div_q_per_s, double porosity, double dt_s) {
+  return ln_J + dt_s * div_q_per_s / porosity;
 }
 
 /// Fluid Cauchy stress σ_f = τ_f − p_f 1 [Pa] (E25) for a given pressure p_f [Pa].

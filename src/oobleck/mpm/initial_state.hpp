@@ -37,9 +37,9 @@ void set_hydrostatic_bed(const HydrostaticBed& bed, Body<G>* grains, Body<G>* fl
     for (std::int64_t p = 0; p < fluid->size(); ++p) {
       const double depth = std::max(bed.surface_m - fluid->x_m[p][v], 0.0);
       const double pf = bed.rho_f0_kg_m3 * bed.g_m_s2 * depth;
-      const double J = std::exp(-pf / kappa);
-      if (law) law->J[p] = J;
-      fluid->mass_kg[p] /= J;
+      const double ln_J = -pf / kappa;  // E26
+      if (law) law->ln_J[p] = ln_J;
+      fluid->mass_kg[p] /= std::exp(ln_J);
       fluid->stress_Pa[p] = -pf * Mat3::Identity();
       fluid->phi[p] = bed.phi_bed;
     }

@@ -6,7 +6,6 @@
 #include "oobleck/material/elastic.hpp"
 #include "oobleck/material/fluid.hpp"
 #include "oobleck/mpm/body.hpp"
-#include "oobleck/numerics/vector_math.hpp"
 
 namespace oobleck::mpm {
 
@@ -42,50 +41,37 @@ class LinearElasticLaw final : public StressLaw<G> {
   std::int64_t first_bad_ = kNotChecked;
 };
 
-/// Fluid phase of a mixture (E25–E27). State: J = ρ_f0/ρ_f per point. Needs body.phi and
+/// Fluid phase of a mixture (E25–E27). State: ln J, J = ρ_f0/ρ_f, per point. Needs body.phi and
 /// body.div_q_1_s, which the solver's G2P fills for the fluid body from the nodal porosity and
 /// mixture flux. `min_porosity` bounds n in the J update (model.md §5).
 template <class G>
 class FluidLaw final : public StressLaw<G> {
  public:
   FluidLaw(const material::FluidParams& p, double min_porosity) : p_(p), n_min_(min_porosity) {}
-  void resize(std::int64_t n) override { J.resize(static_cast<std::size_t>(n), 1.0); }
-  /// E27 J ← J exp(Δt div q / n) (material::update_fluid_volume_ratio), E26 p_f = −κ ln J
-  /// (material::fluid_pressure) and E25, for blocks of points with the exp and log in vector lanes
-  /// (numerics/vector_math.hpp).
+  void resize(std::int64_t n) override { ln_J.resize(static_cast<std::size_t>(n), 0.0); }
+  /// E27 in logarithms, ln J ← ln J + Δt div q / n (material::update_fluid_log_volume_ratio), E26
+  /// p_f = −κ ln J (material::fluid_pressure_from_log_volume_ratio) and E25. (The state is ln J,
+  /// not J: the exponential update of E27 and the logarithm of E26 cancel, and ln J ≈ −p_f/κ keeps
+  /// its relative precision where J is within 1e-3 of 1.)
   void update_stress(Body<G>& body, double dt_s) override {
     const std::int64_t np = body.size();
-    constexpr int kBlock = numerics::kMathBlock;
-    const std::int64_t blocks = (np + kBlock - 1) / kBlock;
     std::int64_t bad = kAllFinite;
 #pragma omp parallel for schedule(static) reduction(min : bad)
-    for (std::int64_t blk = 0; blk < blocks; ++blk) {
-      const std::int64_t q0 = blk * kBlock;
-      const int nb = static_cast<int>(std::min<std::int64_t>(kBlock, np - q0));
-      double arg[kBlock], factor[kBlock], Jn[kBlock], lnJ[kBlock];
-      for (int j = 0; j < kBlock; ++j) {
-        const std::int64_t q = q0 + std::min(j, nb - 1);  // (lanes past the end repeat the last point)
-        const double n = std::max(1.0 - body.phi[q], n_min_);
-        arg[j] = dt_s * body.div_q_1_s[q] / n;
-      }
-      numerics::exp_block(arg, factor);
-      for (int j = 0; j < kBlock; ++j) Jn[j] = J[q0 + std::min(j, nb - 1)] * factor[j];  // E27
-      numerics::log_block(Jn, lnJ);
-      for (int j = 0; j < nb; ++j) {
-        const std::int64_t q = q0 + j;
-        J[q] = Jn[j];
-        const double p_f = -p_.kappa_Pa * lnJ[j];  // E26
-        body.stress_Pa[q] = material::fluid_cauchy_stress_at_pressure(body.L_1_s[q], body.phi[q], p_f, p_.eta_0_Pa_s);
-        if (!std::isfinite(body.stress_Pa[q].sum())) bad = std::min(bad, q);
-      }
+    for (std::int64_t q = 0; q < np; ++q) {
+      const double n = std::max(1.0 - body.phi[q], n_min_);
+      const double lj = material::update_fluid_log_volume_ratio(ln_J[q], body.div_q_1_s[q], n, dt_s);  // E27
+      ln_J[q] = lj;
+      const double p_f = material::fluid_pressure_from_log_volume_ratio(lj, p_.kappa_Pa);  // E26
+      body.stress_Pa[q] = material::fluid_cauchy_stress_at_pressure(body.L_1_s[q], body.phi[q], p_f, p_.eta_0_Pa_s);
+      if (!std::isfinite(body.stress_Pa[q].sum())) bad = std::min(bad, q);
     }
     first_bad_ = bad;
   }
   std::int64_t first_non_finite_stress() const override { return first_bad_; }
   double max_wave_speed(const Body<G>&) const override {
-    double J_max = 1.0;
-    for (double j : J) J_max = std::max(J_max, j);
-    return material::fluid_wave_speed(p_.kappa_Pa, p_.rho_f0_kg_m3 / J_max);
+    double ln_J_max = 0.0;  // (J ≥ 1: the density at rest or below)
+    for (double lj : ln_J) ln_J_max = std::max(ln_J_max, lj);
+    return material::fluid_wave_speed(p_.kappa_Pa, p_.rho_f0_kg_m3 / std::exp(ln_J_max));
   }
   double viscous_dt_limit(const Body<G>& body, double h_m) const override {
     double phi_max = 0.0;
@@ -94,7 +80,7 @@ class FluidLaw final : public StressLaw<G> {
   }
   const char* name() const override { return "fluid"; }
   const material::FluidParams& params() const { return p_; }
-  std::vector<double> J;  ///< ρ_f0/ρ_f per point
+  std::vector<double> ln_J;  ///< ln(ρ_f0/ρ_f) per point (E26: p_f = −κ ln J)
 
  private:
   material::FluidParams p_;

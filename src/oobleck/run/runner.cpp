@@ -309,9 +309,9 @@ void SceneRun<G>::fill_regions() {
       auto& fl = solver_->body(fluid_);
       for (std::int64_t p = 0; p < fl.size(); ++p) {
         const double pf = rho_mix * g * std::max(surface - fl.x_m[p][D - 1], 0.0);
-        const double J = std::exp(-pf / cfg_.fluid.kappa_Pa);
-        fluid_law_->J[p] = J;
-        fl.mass_kg[p] /= J;
+        const double ln_J = -pf / cfg_.fluid.kappa_Pa;
+        fluid_law_->ln_J[p] = ln_J;
+        fl.mass_kg[p] /= std::exp(ln_J);
         fl.stress_Pa[p] = -pf * mpm::Mat3::Identity();
         fl.phi[p] = phi_bed;
       }
@@ -592,7 +592,11 @@ void SceneRun<G>::write_frame(io::FrameWriter& frames) {
       cloud.scalar("f", granular_law_->f).scalar("phi", phi).scalar("tau_bar", tau);
       cloud.scalar("regime", regime).scalar("gamma_dot_p", granular_law_->gamma_dot_p);
     }
-    if (b == fluid_) cloud.scalar("phi", body.phi).scalar("J", fluid_law_->J);
+    if (b == fluid_) {
+      auto& J = column(n);  // (the frames show J = ρ_f0/ρ_f; the law's state is ln J)
+      for (std::size_t p = 0; p < n; ++p) J[p] = std::exp(fluid_law_->ln_J[p]);
+      cloud.scalar("phi", body.phi).scalar("J", J);
+    }
     frame.bodies.push_back(std::move(cloud));
   }
   // Nodal porosity on the physical nodes (x fastest), when there is a mixture.
@@ -698,7 +702,7 @@ void SceneRun<G>::for_each_point_array(F&& f) const {
     f("granular/regime", granular_law_->regime);
     f("granular/gamma_dot_p", granular_law_->gamma_dot_p);
   }
-  if (fluid_law_) f("fluid/J", fluid_law_->J);
+  if (fluid_law_) f("fluid/ln_J", fluid_law_->ln_J);
 }
 
 template <class G>
@@ -767,7 +771,18 @@ void SceneRun<G>::restore(const io::Checkpoint& cp) {
     throw InputError(fmt::format("{}: time step {} s differs from the checkpoint's {} s", cp.file(), dt_,
                                  cp.real_attribute("dt")));
   }
-  for_each_point_array([&](const std::string& name, auto&& a) { cp.read_into(name, a); });
+  for_each_point_array([&](const std::string& name, auto&& a) {
+    if constexpr (std::is_same_v<std::remove_cvref_t<decltype(a)>, std::vector<double>>) {
+      if (name == "fluid/ln_J" && !cp.has(name) && cp.has("fluid/J")) {
+        // A checkpoint of a version before the fluid's state became ln J: its J, in logarithms
+        // (the continued run differs from an uninterrupted one by that logarithm's round-off).
+        cp.read_into("fluid/J", a);
+        for (double& x : a) x = std::log(x);
+        return;
+      }
+    }
+    cp.read_into(name, a);
+  });
   for (std::size_t k = 0; k < third_.size(); ++k) {
     auto& rm = solver_->rigid_motion(third_[k].body);
     cp.read_into(fmt::format("third{}/rigid_velocity", k), std::span<double>(rm.velocity_m_s.data(), NC));
