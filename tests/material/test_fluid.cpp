@@ -62,6 +62,24 @@ TEST(Fluid, ExponentialVolumeUpdateIsExactForConstantRate) {
   EXPECT_NEAR(J, std::exp(0.1), 1e-15);
 }
 
+TEST(Fluid, LogarithmicVolumeUpdateIsTheLogOfTheExponentialOne) {
+  // E27 in logarithms: ln J(t) = ln J0 + t div q / n, exactly the logarithm of the exponential
+  // update, and E26 from it: p_f = −κ ln J.
+  const double divq = -3.0, n = 0.5, T = 0.1, kappa = 2e6;
+  for (int steps : {1, 7, 1000}) {
+    double lnJ = 0.0, J = 1.0;
+    for (int i = 0; i < steps; ++i) {
+      lnJ = m::update_fluid_log_volume_ratio(lnJ, divq, n, T / steps);
+      J = m::update_fluid_volume_ratio(J, divq, n, T / steps);
+    }
+    EXPECT_NEAR(lnJ, T * divq / n, 1e-14);
+    EXPECT_NEAR(lnJ, std::log(J), 1e-13);
+    EXPECT_NEAR(m::fluid_pressure_from_log_volume_ratio(lnJ, kappa), m::fluid_pressure(J, kappa), 1e-6);
+  }
+  // 1% compression (J = 0.99): p_f = κ ln(1/0.99) > 0.
+  EXPECT_NEAR(m::fluid_pressure_from_log_volume_ratio(std::log(0.99), kappa), kappa * std::log(1.0 / 0.99), 1e-9);
+}
+
 TEST(Fluid, CauchyStressCombinesViscousAndPressure) {
   m::FluidParams p;
   p.eta_0_Pa_s = 1e-3;

@@ -3,6 +3,7 @@
 // restart equality, and refusal of invalid scenes before any output.
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 
 #include <gtest/gtest.h>
@@ -32,6 +33,26 @@ nlohmann::json run_verification(const std::string& scene, const std::string& out
   return run::run_scene(scene::load_scene(kScenes + scene, sets), o);
 }
 double rel(double a, double b) { return std::fabs(a - b) / std::fabs(b); }
+
+/// The settling scene run to step 359 with checkpoints every 100 steps ("full"), and run to step
+/// 150 ("part"), its checkpoint passed to `edit` (the path), then restarted to the end. Returns the
+/// two checkpoints of step 300.
+std::pair<io::Checkpoint, io::Checkpoint> restarted_settling(const clitest::TempDir& d,
+                                                             const std::function<void(const std::string&)>& edit) {
+  run::RunOptions o;
+  o.checkpoint_every = 100;
+  o.threads = 1;
+  run_verification("settling.toml", d / "full", {"time.duration=0.01"}, o);  // 359 steps, checkpoint at 300
+  o.stop_after_steps = 150;
+  run_verification("settling.toml", d / "part", {"time.duration=0.01"}, o);  // stops at 150 with a checkpoint
+  edit(run::checkpoint_path(d / "part"));
+  o.stop_after_steps = -1;
+  o.restart = true;
+  o.out_dir = d / "part";
+  o.quiet = true;
+  run::run_scene(scene::load_scene(run::stored_scene_path(d / "part")), o);
+  return {io::read_checkpoint(run::checkpoint_path(d / "full")), io::read_checkpoint(run::checkpoint_path(d / "part"))};
+}
 }  // namespace
 
 TEST(RunScenes, SettlingVelocityMatchesDragBuoyancyBalanceV4) {
@@ -85,19 +106,7 @@ TEST(RunScenes, TaylorCouetteTorquesV3) {
 
 TEST(RunScenes, RestartContinuesBitForBit) {
   clitest::TempDir d;
-  run::RunOptions o;
-  o.checkpoint_every = 100;
-  o.threads = 1;
-  run_verification("settling.toml", d / "full", {"time.duration=0.01"}, o);          // 359 steps, checkpoint at 300
-  o.stop_after_steps = 150;
-  run_verification("settling.toml", d / "part", {"time.duration=0.01"}, o);          // stops at 150 with a checkpoint
-  o.stop_after_steps = -1;
-  o.restart = true;
-  o.out_dir = d / "part";
-  o.quiet = true;
-  run::run_scene(scene::load_scene(run::stored_scene_path(d / "part")), o);
-  const auto a = io::read_checkpoint(run::checkpoint_path(d / "full"));
-  const auto b = io::read_checkpoint(run::checkpoint_path(d / "part"));
+  const auto [a, b] = restarted_settling(d, [](const std::string&) {});
   ASSERT_EQ(a.step(), 300);
   ASSERT_EQ(b.step(), 300);
   EXPECT_EQ(a.time(), b.time());
@@ -112,6 +121,51 @@ TEST(RunScenes, RestartContinuesBitForBit) {
   // The series of the restarted run continues without duplicate rows.
   const auto s = io::read_csv(d / "part/series.csv").column("step");
   for (std::size_t i = 1; i < s.size(); ++i) ASSERT_GT(s[i], s[i - 1]);
+}
+
+TEST(RunScenes, RestartReadsAnOlderCheckpointWithJ) {
+  // Checkpoints before the fluid's state became ln J stored J = ρ_f0/ρ_f as "fluid/J": such a
+  // file restarts through the logarithm, and the run continues within that logarithm's round-off.
+  clitest::TempDir d;
+  const auto [a, b] = restarted_settling(d, [](const std::string& path) {
+    // The part's checkpoint rewritten in the older form: every array and attribute, J for ln J.
+    const auto cp = io::read_checkpoint(path);
+    ASSERT_TRUE(cp.has("fluid/ln_J"));
+    io::CheckpointWriter w(path);
+    w.set_step(cp.step());
+    w.set_time(cp.time());
+    w.set_config(cp.config());
+    w.attribute("dt", cp.real_attribute("dt"));
+    w.attribute("settle_sum", cp.real_attribute("settle_sum"));
+    for (const char* k : {"threads", "settle_samples", "next_snapshot"}) w.attribute(k, cp.int_attribute(k));
+    for (const auto& n : cp.names()) {
+      if (n == "fluid/ln_J") {
+        std::vector<double> J = cp.doubles(n);
+        for (double& x : J) x = std::exp(x);
+        w.array("fluid/J", J);
+      } else if (n == "granular/regime") {
+        w.array(n, cp.bytes(n), cp.shape(n));
+      } else {
+        w.array(n, cp.doubles(n), cp.shape(n));
+      }
+    }
+    w.commit();
+  });
+  ASSERT_EQ(b.step(), 300);
+  ASSERT_TRUE(b.has("fluid/ln_J"));
+  for (const char* n : {"fluid/ln_J", "body0/x", "body1/x", "body1/stress"}) {
+    const auto& x = a.doubles(n);
+    const auto& y = b.doubles(n);
+    ASSERT_EQ(x.size(), y.size()) << n;
+    double scale = 0.0, diff = 0.0;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      scale = std::max(scale, std::fabs(x[i]));
+      diff = std::max(diff, std::fabs(x[i] - y[i]));
+    }
+    EXPECT_GT(scale, 0.0) << n;
+    EXPECT_LE(diff, 1e-9 * scale) << n;
+  }
+  EXPECT_NE(a.doubles("fluid/ln_J"), b.doubles("fluid/ln_J"));  // (the logarithm's round-off: not the same file)
 }
 
 TEST(RunScenes, InvalidScenesAreRefusedBeforeAnyOutput) {
