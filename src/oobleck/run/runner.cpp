@@ -301,7 +301,7 @@ void SceneRun<G>::fill_regions() {
   }
   if (std::isfinite(surface) && suspended) {
     // Grains out of contact: the fluid pressure carries the whole mixture weight,
-    // p_f = rho_mix g depth with rho_mix = phi rho_s + (1 - phi) rho_f (E26: J = exp(-p_f/kappa)),
+    // p_f = rho_mix g depth with rho_mix = phi rho_s + (1 - phi) rho_f (E26: ln J = -p_f/kappa),
     // and the granular stress is zero.
     const double g = -cfg_.gravity_m_s2[D - 1];
     const double rho_mix = phi_bed * rho_s + (1.0 - phi_bed) * rho_f;
