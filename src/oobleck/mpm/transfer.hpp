@@ -336,15 +336,16 @@ std::int64_t particles_to_grid(const Body<G>& body, const Grid<G::dim>& grid, co
       for (std::int64_t p = 0; p < np; ++p) {
         if (!make_stencil(grid, sg, kernel, body.x_m[p], cache.template stencil<S>(p), cache.inv_D[p])) ++bad;
         if constexpr (G::has_hoop_terms) {
-          // Beds without swirl (the intruder, the rod) skip the θ terms: the same sums.
-          if (detail::point_without_swirl(body, p)) {
+          // Beds without swirl (the intruder, the rod) skip the θ terms: the same sums; points
+          // with swirl take the general kernel.
+          if (detail::point_without_swirl(body, p))
             detail::particles_to_grid_point<G, K, A, Sp, true>(body, cache, p, m, mvd, fd, fpd, vol);
-            continue;
-          }
+          else
+            detail::particles_to_grid_point<G, K, A, Sp>(body, cache, p, m, mvd, fd, fpd, vol);
+        } else {
+          // (plane strain and 3D: inlined here)
+          detail::particles_to_grid_point_inlined<G, K, A, Sp>(body, cache, p, m, mvd, fd, fpd, vol);
         }
-        // (axisymmetric with swirl: the general kernel; plane strain and 3D: inlined here)
-        if constexpr (G::has_hoop_terms) detail::particles_to_grid_point<G, K, A, Sp>(body, cache, p, m, mvd, fd, fpd, vol);
-        else detail::particles_to_grid_point_inlined<G, K, A, Sp>(body, cache, p, m, mvd, fd, fpd, vol);
       }
     };
     if (apic) {
