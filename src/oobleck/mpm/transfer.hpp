@@ -307,6 +307,8 @@ std::int64_t particles_to_grid(const Body<G>& body, const Grid<G::dim>& grid, co
   const StencilGrid<G::dim> sg(grid);
   int team = 1;
   std::int64_t bad = 0;
+  const bool gravity = gravity_m_s2 != nullptr && gravity_m_s2->squaredNorm() != 0.0;
+  const Vec<NC> g = gravity ? *gravity_m_s2 : Vec<NC>::Zero();
 #pragma omp parallel num_threads(field.max_threads())
   {
     const int t = omp_get_thread_num();
@@ -355,26 +357,22 @@ std::int64_t particles_to_grid(const Body<G>& body, const Grid<G::dim>& grid, co
       if (split_pressure) scatter.template operator()<false, true>();
       else scatter.template operator()<false, false>();
     }
-  }
-  const bool gravity = gravity_m_s2 != nullptr && gravity_m_s2->squaredNorm() != 0.0;
-  if (team > 1) {
-    // The copies' sums, and the body load of step 3 (gravity) on the summed mass in the same pass.
-    const Vec<NC> g = gravity ? *gravity_m_s2 : Vec<NC>::Zero();
-#pragma omp parallel for schedule(static) num_threads(team) if (nn >= kParallelMinNodes / 8)  // ~5 ns per node and copy
+    // (the scatter loop's barrier: every copy is complete) The copies' sums in thread order, and
+    // the body load of step 3 (gravity) on the summed mass, in the same region (no second
+    // fork; each node is summed by one thread, in the same order whichever it is).
+#pragma omp for schedule(static) nowait
     for (int i = 0; i < nn; ++i) {
-      for (int t = 1; t < team; ++t) {
-        field.mass_kg[i] += field.t_mass[t - 1][i];
-        field.momentum[i] += field.t_momentum[t - 1][i];
-        field.force_N[i] += field.t_force[t - 1][i];
+      for (int u = 1; u < team; ++u) {
+        field.mass_kg[i] += field.t_mass[u - 1][i];
+        field.momentum[i] += field.t_momentum[u - 1][i];
+        field.force_N[i] += field.t_force[u - 1][i];
         if (split_pressure) {
-          field.pressure_force_N[i] += field.t_pressure[t - 1][i];
-          field.volume_m3[i] += field.t_volume[t - 1][i];
+          field.pressure_force_N[i] += field.t_pressure[u - 1][i];
+          field.volume_m3[i] += field.t_volume[u - 1][i];
         }
       }
       if (gravity) field.force_N[i] += field.mass_kg[i] * g;
     }
-  } else if (gravity) {
-    add_gravity(field, *gravity_m_s2);
   }
   return bad;
 }
