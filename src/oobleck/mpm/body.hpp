@@ -5,6 +5,7 @@
 // Each field is one contiguous array over the points. Per-law state (e.g. f and φ of the granular
 // phase, J of the fluid) lives in the law object attached to the body, again one array per
 // variable; the law updates the body's stress from the body's velocity gradient once per step.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -32,8 +33,28 @@ class StressLaw {
   virtual ~StressLaw() = default;
   /// Called whenever points are added, so the law can size its state (new points get defaults).
   virtual void resize(std::int64_t n_points) = 0;
-  /// Update body.stress from body.L (and the law's state) over one step of length dt [s].
-  virtual void update_stress(Body<G>& body, double dt_s) = 0;
+  /// Update body.stress from body.L (and the law's state) over one step of length dt [s]: every
+  /// chunk (update_chunk, in parallel), then end_update.
+  void update_stress(Body<G>& body, double dt_s) {
+    const std::int64_t chunks = chunk_count(body);
+    std::int64_t bad = kAllFinite;
+#pragma omp parallel for schedule(dynamic, 1) reduction(min : bad)
+    for (std::int64_t c = 0; c < chunks; ++c) bad = std::min(bad, update_chunk(body, dt_s, c));
+    end_update(body, dt_s, bad);
+  }
+  /// The update in independent chunks of points, so that the solver runs the chunks of every
+  /// body's law in one parallel loop (Solver::update_stresses: one fork per step, and a thread
+  /// that is done with cheap chunks takes costly ones). The number of chunks of the step;
+  virtual std::int64_t chunk_count(const Body<G>& body) const = 0;
+  /// chunk c's update; returns the lowest index of a point of the chunk whose new stress is not
+  /// finite, or kAllFinite. Chunks touch only their own points' state.
+  virtual std::int64_t update_chunk(Body<G>& body, double dt_s, std::int64_t c) = 0;
+  /// Once after all chunks, with the lowest such index over the body (a law that stops the run
+  /// on it throws here).
+  virtual void end_update(Body<G>& body, double dt_s, std::int64_t first_bad) = 0;
+  /// Cost of one point's update relative to a simple law's (the solver starts the costly chunks
+  /// first, so that the cheap ones fill in at the end).
+  virtual double relative_cost_per_point() const { return 1.0; }
   /// Fastest wave speed [m/s] at the current state (for the stable time step, model.md §6).
   virtual double max_wave_speed(const Body<G>& body) const = 0;
   /// Largest stable Δt [s] of the law's own diffusion on a grid of cell size h (viscous limit

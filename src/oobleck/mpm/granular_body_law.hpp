@@ -44,52 +44,54 @@ class GranularBodyLaw final : public StressLaw<G> {
   /// (advance_batch's in_plane: the same results, 9% less time for the law on the wheel's bed).
   static constexpr bool kInPlane = std::is_same_v<G, PlaneStrain>;
 
-  void update_stress(Body<G>& body, double dt_s) override {
-    const std::int64_t np = body.size();
-    std::int64_t first_bad = std::numeric_limits<std::int64_t>::max();
-    // Dynamic chunks: the cost per point ranges from a closed form to tens of Newton steps and
-    // an implicit structure solve, and it is clustered in space (points are stored by region), so
-    // a static split left one thread waiting (rod impact: 1.3x faster stress pass on 2 threads).
-    // Each point is independent: the results do not depend on the schedule. Within a chunk the
-    // law runs its Newton iterations in lanes across points (GranularLaw::advance_batch).
-    constexpr std::int64_t kChunk = 256;
-    const std::int64_t chunks = (np + kChunk - 1) / kChunk;
-#pragma omp parallel for schedule(dynamic, 1) reduction(min : first_bad)
-    for (std::int64_t c = 0; c < chunks; ++c) {
-      const std::int64_t q0 = c * kChunk, m = std::min(kChunk, np - q0);
-      double phi[kChunk];
-      material::GranularStep step[kChunk];
-      for (std::int64_t i = 0; i < m; ++i) phi[i] = phi_of(body, q0 + i);
+  // Chunks of kChunk points: the cost per point ranges from a closed form to tens of Newton steps
+  // and an implicit structure solve, and it is clustered in space (points are stored by region),
+  // so the chunks are handed out dynamically (Solver::update_stresses; a static split left one
+  // thread waiting: rod impact, 1.3x faster stress pass on 2 threads). Each point is
+  // independent: the results do not depend on the schedule. Within a chunk the law runs its
+  // Newton iterations in lanes across points (GranularLaw::advance_batch).
+  std::int64_t chunk_count(const Body<G>& body) const override { return (body.size() + kChunk - 1) / kChunk; }
+  std::int64_t update_chunk(Body<G>& body, double dt_s, std::int64_t c) override {
+    const std::int64_t q0 = c * kChunk, m = std::min(kChunk, body.size() - q0);
+    if (m <= 0) return kAllFinite;
+    double phi[kChunk];
+    material::GranularStep step[kChunk];
+    for (std::int64_t i = 0; i < m; ++i) phi[i] = phi_of(body, q0 + i);
 #ifndef NDEBUG
-      if constexpr (kInPlane)
-        for (std::int64_t i = 0; i < m; ++i)
-          for (int e : {2, 5, 6, 7})
-            assert(body.stress_Pa[q0 + i].data()[e] == 0.0 && body.L_1_s[q0 + i].data()[e] == 0.0);
+    if constexpr (kInPlane)
+      for (std::int64_t i = 0; i < m; ++i)
+        for (int e : {2, 5, 6, 7})
+          assert(body.stress_Pa[q0 + i].data()[e] == 0.0 && body.L_1_s[q0 + i].data()[e] == 0.0);
 #endif
-      law_.advance_batch(m, body.stress_Pa.data() + q0, f.data() + q0, body.L_1_s.data() + q0, phi, dt_s, step,
-                         kInPlane);
-      for (std::int64_t i = 0; i < m; ++i) {
-        if (!step[i].ok) {
-          first_bad = std::min(first_bad, q0 + i);
-          continue;
-        }
-        regime[q0 + i] = static_cast<std::uint8_t>(step[i].regime);
-        gamma_dot_p[q0 + i] = step[i].gamma_dot_p;
+    law_.advance_batch(m, body.stress_Pa.data() + q0, f.data() + q0, body.L_1_s.data() + q0, phi, dt_s, step,
+                       kInPlane);
+    std::int64_t first_bad = kAllFinite;
+    for (std::int64_t i = 0; i < m; ++i) {
+      if (!step[i].ok) {
+        first_bad = std::min(first_bad, q0 + i);
+        continue;
       }
+      regime[q0 + i] = static_cast<std::uint8_t>(step[i].regime);
+      gamma_dot_p[q0 + i] = step[i].gamma_dot_p;
     }
-    if (first_bad != std::numeric_limits<std::int64_t>::max()) {
-      const std::int64_t q = first_bad;
-      const Mat3& L = body.L_1_s[q];
-      const Mat3 D = 0.5 * (L + L.transpose());
-      const Mat3 W = 0.5 * (L - L.transpose());
-      const material::GranularState before{body.stress_Pa[q], f[q]};
-      material::GranularState after = before;
-      const auto u = law_.update(after, D, W, dt_s, phi_of(body, q));
-      throw NumericalError(fmt::format("body '{}', point {} at x = ({}): {}", body.name, q,
-                                       fmt::join(body.x_m[q].data(), body.x_m[q].data() + G::dim, ", "),
-                                       law_.describe(u, before, D, W, dt_s, phi_of(body, q))));
-    }
+    return first_bad;
   }
+  /// A point whose update failed stops the run with the diagnosis (its state was left as it was).
+  void end_update(Body<G>& body, double dt_s, std::int64_t first_bad) override {
+    if (first_bad == kAllFinite) return;
+    const std::int64_t q = first_bad;
+    const Mat3& L = body.L_1_s[q];
+    const Mat3 D = 0.5 * (L + L.transpose());
+    const Mat3 W = 0.5 * (L - L.transpose());
+    const material::GranularState before{body.stress_Pa[q], f[q]};
+    material::GranularState after = before;
+    const auto u = law_.update(after, D, W, dt_s, phi_of(body, q));
+    throw NumericalError(fmt::format("body '{}', point {} at x = ({}): {}", body.name, q,
+                                     fmt::join(body.x_m[q].data(), body.x_m[q].data() + G::dim, ", "),
+                                     law_.describe(u, before, D, W, dt_s, phi_of(body, q))));
+  }
+  /// (a point takes ≈ 10× the fluid's update: the trial, the branch, Newton lanes)
+  double relative_cost_per_point() const override { return 10.0; }
 
   /// Fastest granular wave: sqrt((K + 4G/3)/(phi rho_s)) at the loosest point (phi >= 0.05 so
   /// isolated surface points do not stall the run; they carry no stress when separated).
@@ -109,6 +111,7 @@ class GranularBodyLaw final : public StressLaw<G> {
   std::vector<double> gamma_dot_p;       ///< plastic shear rate of the last step [1/s]
 
  private:
+  static constexpr std::int64_t kChunk = 256;  ///< points per chunk
   material::GranularLaw law_;
   double rho_s_, G_, K_;
 };

@@ -15,16 +15,17 @@ class LinearElasticLaw final : public StressLaw<G> {
  public:
   explicit LinearElasticLaw(const material::LinearElasticParams& p) : p_(p) {}
   void resize(std::int64_t) override {}
-  void update_stress(Body<G>& body, double dt_s) override {
-    const std::int64_t np = body.size();
+  std::int64_t chunk_count(const Body<G>& body) const override { return (body.size() + kChunk - 1) / kChunk; }
+  std::int64_t update_chunk(Body<G>& body, double dt_s, std::int64_t c) override {
+    const std::int64_t q1 = std::min(body.size(), (c + 1) * kChunk);
     std::int64_t bad = kAllFinite;
-#pragma omp parallel for schedule(static) reduction(min : bad)
-    for (std::int64_t q = 0; q < np; ++q) {
+    for (std::int64_t q = c * kChunk; q < q1; ++q) {
       body.stress_Pa[q] = material::linear_elastic_update(body.stress_Pa[q], body.L_1_s[q], dt_s, p_);
       if (!std::isfinite(body.stress_Pa[q].sum())) bad = std::min(bad, q);
     }
-    first_bad_ = bad;
+    return bad;
   }
+  void end_update(Body<G>&, double, std::int64_t first_bad) override { first_bad_ = first_bad; }
   std::int64_t first_non_finite_stress() const override { return first_bad_; }
   double max_wave_speed(const Body<G>& body) const override {
     // c = √(M/ρ) at the lightest point (current density m/V), the fastest wave.
@@ -37,6 +38,7 @@ class LinearElasticLaw final : public StressLaw<G> {
   const material::LinearElasticParams& params() const { return p_; }
 
  private:
+  static constexpr std::int64_t kChunk = 1024;  ///< points per chunk (≈ 10 µs of work)
   material::LinearElasticParams p_;
   std::int64_t first_bad_ = kNotChecked;
 };
@@ -53,11 +55,11 @@ class FluidLaw final : public StressLaw<G> {
   /// p_f = −κ ln J (material::fluid_pressure_from_log_volume_ratio) and E25. (The state is ln J,
   /// not J: the exponential update of E27 and the logarithm of E26 cancel, and ln J ≈ −p_f/κ keeps
   /// its relative precision where J is within 1e-3 of 1.)
-  void update_stress(Body<G>& body, double dt_s) override {
-    const std::int64_t np = body.size();
+  std::int64_t chunk_count(const Body<G>& body) const override { return (body.size() + kChunk - 1) / kChunk; }
+  std::int64_t update_chunk(Body<G>& body, double dt_s, std::int64_t c) override {
+    const std::int64_t q1 = std::min(body.size(), (c + 1) * kChunk);
     std::int64_t bad = kAllFinite;
-#pragma omp parallel for schedule(static) reduction(min : bad)
-    for (std::int64_t q = 0; q < np; ++q) {
+    for (std::int64_t q = c * kChunk; q < q1; ++q) {
       const double n = std::max(1.0 - body.phi[q], n_min_);
       const double lj = material::update_fluid_log_volume_ratio(ln_J[q], body.div_q_1_s[q], n, dt_s);  // E27
       ln_J[q] = lj;
@@ -65,8 +67,9 @@ class FluidLaw final : public StressLaw<G> {
       body.stress_Pa[q] = material::fluid_cauchy_stress_at_pressure(body.L_1_s[q], body.phi[q], p_f, p_.eta_0_Pa_s);
       if (!std::isfinite(body.stress_Pa[q].sum())) bad = std::min(bad, q);
     }
-    first_bad_ = bad;
+    return bad;
   }
+  void end_update(Body<G>&, double, std::int64_t first_bad) override { first_bad_ = first_bad; }
   std::int64_t first_non_finite_stress() const override { return first_bad_; }
   double max_wave_speed(const Body<G>&) const override {
     double ln_J_max = 0.0;  // (J ≥ 1: the density at rest or below)
@@ -83,6 +86,7 @@ class FluidLaw final : public StressLaw<G> {
   std::vector<double> ln_J;  ///< ln(ρ_f0/ρ_f) per point (E26: p_f = −κ ln J)
 
  private:
+  static constexpr std::int64_t kChunk = 1024;  ///< points per chunk (≈ 10 µs of work)
   material::FluidParams p_;
   double n_min_;
   std::int64_t first_bad_ = kNotChecked;

@@ -18,6 +18,7 @@
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -522,9 +523,38 @@ class Solver {
     }
   }
 
+  /// Step 8 for every body in one parallel loop over the chunks of all laws
+  /// (StressLaw::update_chunk), the costliest bodies' first, handed out dynamically: one fork per
+  /// step, and the thread that is done with its share of the costly granular chunks early takes
+  /// more of them while the other finishes; the cheap fluid chunks fill in at the end. Each point's
+  /// update is independent of the others, so the results do not depend on the schedule.
   void update_stresses() {
-    for (auto& b : bodies_)
-      if (b->law) b->law->update_stress(*b, opt_.dt_s);
+    const int nb = static_cast<int>(bodies_.size());
+    law_bodies_.clear();
+    for (int b = 0; b < nb; ++b)
+      if (bodies_[b]->law) law_bodies_.push_back(b);
+    std::stable_sort(law_bodies_.begin(), law_bodies_.end(), [&](int a, int b) {
+      return bodies_[a]->law->relative_cost_per_point() > bodies_[b]->law->relative_cost_per_point();
+    });
+    law_chunks_.clear();
+    for (int b : law_bodies_) {
+      const std::int64_t chunks = bodies_[b]->law->chunk_count(*bodies_[b]);
+      for (std::int64_t c = 0; c < chunks; ++c) law_chunks_.emplace_back(b, c);
+    }
+    law_first_bad_.assign(bodies_.size(), kAllFinite);
+    const auto items = static_cast<std::int64_t>(law_chunks_.size());
+    const double dt = opt_.dt_s;
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t k = 0; k < items; ++k) {
+      const auto [b, c] = law_chunks_[static_cast<std::size_t>(k)];
+      const std::int64_t bad = bodies_[b]->law->update_chunk(*bodies_[b], dt, c);
+      if (bad != kAllFinite) {
+#pragma omp critical(oobleck_law_first_bad)
+        law_first_bad_[b] = std::min(law_first_bad_[b], bad);
+      }
+    }
+    for (int b = 0; b < nb; ++b)  // (in body order, as the laws were run before)
+      if (bodies_[b]->law) bodies_[b]->law->end_update(*bodies_[b], dt, law_first_bad_[b]);
   }
 
   Grid<D> grid_;
@@ -547,6 +577,11 @@ class Solver {
   std::vector<GridField<G>*> solids_;  ///< scratch of update_grid_and_couple (refilled per call): deformable solids' fields
   std::vector<double> porosity_;  ///< nodal porosity n_i of the mixture
   std::vector<Vec<NC>> flux_;     ///< nodal mixture volume flux q_i
+  // scratch of update_stresses (refilled per call): bodies with a law, costliest first; the
+  // (body, chunk) work items; per body the lowest index of a non-finite result
+  std::vector<int> law_bodies_;
+  std::vector<std::pair<int, std::int64_t>> law_chunks_;
+  std::vector<std::int64_t> law_first_bad_;
   double time_s_ = 0.0;
   std::int64_t steps_ = 0;
 };
