@@ -490,7 +490,7 @@ class Solver {
     const GridField<G>& f = fields_[fluid_];
     const int nn = f.nodes();
     flux_.resize(static_cast<std::size_t>(nn));
-#pragma omp parallel for schedule(static) if (nn >= kParallelMinNodes)
+#pragma omp parallel for schedule(static) if (nn >= kParallelMinNodes / 8)  // (the wheel's 12 000 nodes: 0.4% of a two-thread step when serial)
     for (int i = 0; i < nn; ++i) {
       const double n = porosity_[i];
       flux_[i] = (1.0 - n) * s.velocity[i] + n * f.velocity[i];
