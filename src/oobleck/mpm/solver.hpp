@@ -8,7 +8,9 @@
 //
 // Each body has its own grid field. The phase coupling (porosity, buoyancy split, semi-implicit
 // drag, model.md §5) runs in `update_grid_and_couple()` between the wall folding and the boundary
-// conditions; contact with third bodies (§8, contact.hpp) follows it in `resolve_contacts()`.
+// conditions; contact with third bodies (§8, contact.hpp) scatters its mass gradients beside it
+// (`scatter_contact_gradients()`, on one thread of that pass) and follows it in
+// `resolve_contacts()`.
 // Rigid bodies (prescribed or free translation) and motors: see contact.hpp and docs/contact.md.
 #include <algorithm>
 #include <cmath>
@@ -234,10 +236,12 @@ class Solver {
                                            //    the threads' copies; motors later)
       clock.lap(timings_.p2g);
       fold_wall_images_all();              // 4a. walls: ghost contributions onto mirrors
-      update_grid_and_couple();            // per node, fused: 3a. porosity n_i, buoyancy split
-                                           // E28, ∇p_0; 5. v = (mv + Δt f)/m with all non-drag
-                                           // forces; 3b. semi-implicit E29 drag; rigid bodies
-      resolve_contacts<K>();               // 3c. body contact (§8), rigid-body velocities
+      prepare_contact_arrays();
+      update_grid_and_couple(              // per node, fused: 3a. porosity n_i, buoyancy split
+          [this] { scatter_contact_gradients<K>(); });  // E28, ∇p_0; 5. v = (mv + Δt f)/m with
+                                           // all non-drag forces; 3b. semi-implicit E29 drag;
+                                           // rigid bodies; beside it, contact's mass gradients
+      resolve_contacts();                  // 3c. body contact (§8), rigid-body velocities
       apply_boundary_conditions_all();     // 4b. walls on nodal velocities, ghost images
       compute_mixture_flux();              //     q_i = (1−n_i) v^s_i + n_i v^f_i for E27
       clock.lap(timings_.grid);
@@ -316,7 +320,12 @@ class Solver {
   ///  * predicted velocities v = (mv + Δt f)/m;
   ///  * semi-implicit drag (model.md §5): C_i = V_i C_V(φ_i, Re_i) with the predicted velocities,
   ///    F_d = C_i/(1 + Δt C_i (1/m_s + 1/m_f)) Δv; grains −F_d, fluid +F_d.
-  void update_grid_and_couple() {
+  ///
+  /// `side` (contact's scatters) runs on one thread of the pass while the others start on the
+  /// nodes; the node blocks are handed out dynamically so that thread joins them when it is done
+  /// (each node is independent: the same values whichever thread computes it).
+  template <class Side>
+  void update_grid_and_couple(Side&& side) {
     const double dt = opt_.dt_s;
     // Deformable solids (the wheel): their predictions join the mixture's pass over the nodes
     // below when there is a fluid; otherwise they get their own pass.
@@ -328,6 +337,7 @@ class Solver {
         solids_.push_back(&fields_[b]);
     }
     if (fluid_ < 0) {
+      side();
       for (GridField<G>* sf : solids_) update_grid_velocity(*sf, dt);
       if (grains_ >= 0) update_grid_velocity(fields_[grains_], dt);
       return;
@@ -343,7 +353,11 @@ class Solver {
     // semi-implicit drag.
     constexpr int kBlock = numerics::kMathBlock;
     const int blocks = (nn + kBlock - 1) / kBlock;
-#pragma omp parallel for schedule(static) if (nn >= kParallelMinNodes / 32)  // ~20 ns per node (drag)
+#pragma omp parallel if (nn >= kParallelMinNodes / 32)  // ~20 ns per node (drag)
+    {
+#pragma omp single nowait
+      side();
+#pragma omp for schedule(dynamic, 4) nowait
     for (int blk = 0; blk < blocks; ++blk) {
       const int i0 = blk * kBlock, nb = std::min(kBlock, nn - i0);
       double phi_b[kBlock], Re_b[kBlock], C_V[kBlock];
@@ -390,33 +404,37 @@ class Solver {
         f.force_N[i] += Fd;
       }
     }
+    }
   }
 
-  /// Contact of every pair (model.md §8, contact.hpp), then the free rigid bodies' new velocity
-  /// V = V + Δt g + (Σ impulses)/M on their free components.
-  template <int K>
-  void resolve_contacts() {
-    if (contacts_.empty()) {
-      for (auto& rm : rigid_) rm.velocity_m_s = rm.predicted_m_s;
-      return;
-    }
+  /// Contact (model.md §8), part 1, before the grid pass: the node weights and measures (once)
+  /// and the arrays part 2 fills.
+  void prepare_contact_arrays() {
+    if (contacts_.empty()) return;
     if (contact_weight_.empty()) {  // once: node weights and measures (boundaries are set by now)
       contact_weight_ = detail::contact_node_weights<D>(grid_, bc_);
       node_measure_.resize(contact_weight_.size());
       for (int i = 0; i < grid_.node_count(); ++i) node_measure_[i] = node_measure<G>(grid_, i);
     }
-    GridField<G>* grains = grains_ >= 0 ? &fields_[grains_] : nullptr;
+    mixture_gradient_.resize(contact_weight_.size());
+    mixture_volume_.resize(contact_weight_.size());  // (each pair's arrays are sized with it)
+  }
+
+  /// Contact, part 2: the nodal mass gradients (and volumes) of the mixture near the solids and of
+  /// each solid, from the step's shape functions. It reads only the points and their stencils of
+  /// P2G and writes only contact arrays, so it runs on one thread while the others start the grid
+  /// pass (update_grid_and_couple's side task).
+  template <int K>
+  void scatter_contact_gradients() {
+    if (contacts_.empty()) return;
     GridField<G>* fluid = fluid_ >= 0 ? &fields_[fluid_] : nullptr;
-    // Nodal mixture volume Σ N V_p: the fluid's (its points carry the mixture volume), else the
-    // grains' (scattered here; fluid-free beds).
-    const double* mixture_volume = nullptr;
     bool combined = false;
     for (const auto& c : contacts_) combined = combined || c.combined_normal;
     const int mix = grains_ >= 0 ? grains_ : fluid_;
+    mixture_volume_scattered_ = false;
     if (mix >= 0 && fluid && combined) {
       // Mixture mass gradient only (the fluid gives the volume), from the mixture points near
       // the solids: a box around all contact solids' points, grown by two kernel widths.
-      mixture_gradient_.resize(contact_weight_.size());
       Vec<D> lo = Vec<D>::Constant(INFINITY), hi = Vec<D>::Constant(-INFINITY), ref = Vec<D>::Zero();
       bool any = false;
       for (const auto& c : contacts_) {
@@ -438,16 +456,30 @@ class Solver {
         for (auto& g : mixture_gradient_) g.setZero();
       }
     } else if (mix >= 0 && (combined || !fluid)) {  // mixture mass gradient and/or volume
-      mixture_volume_.resize(contact_weight_.size());
-      mixture_gradient_.resize(contact_weight_.size());
       scatter_mass_gradient_and_volume<G, K>(*bodies_[mix], caches_[mix], combined ? &mixture_gradient_ : nullptr,
                                              mixture_volume_);
-      mixture_volume = mixture_volume_.data();
+      mixture_volume_scattered_ = true;
     }
-    if (fluid) mixture_volume = fluid->volume_m3.data();  // folded at walls, the same points' volumes
+    for (auto& c : contacts_)
+      scatter_mass_gradient_and_volume<G, K>(*bodies_[c.solid], caches_[c.solid], &c.mass_gradient, c.volume_m3);
+  }
+
+  /// Contact, part 3 (after the grid pass): every pair's impulses (model.md §8, contact.hpp),
+  /// then the free rigid bodies' new velocity V = V + Δt g + (Σ impulses)/M on their free
+  /// components.
+  void resolve_contacts() {
+    if (contacts_.empty()) {
+      for (auto& rm : rigid_) rm.velocity_m_s = rm.predicted_m_s;
+      return;
+    }
+    GridField<G>* grains = grains_ >= 0 ? &fields_[grains_] : nullptr;
+    GridField<G>* fluid = fluid_ >= 0 ? &fields_[fluid_] : nullptr;
+    // Nodal mixture volume Σ N V_p: the fluid's (its points carry the mixture volume, folded at
+    // walls), else the grains' (scattered in part 2; fluid-free beds).
+    const double* mixture_volume = mixture_volume_scattered_ ? mixture_volume_.data() : nullptr;
+    if (fluid) mixture_volume = fluid->volume_m3.data();
     for (auto& rm : rigid_) rm.velocity_m_s = rm.predicted_m_s;
     for (auto& c : contacts_) {
-      scatter_mass_gradient_and_volume<G, K>(*bodies_[c.solid], caches_[c.solid], &c.mass_gradient, c.volume_m3);
       RigidMotion<G>& rm = rigid_[c.solid];
       const Vec<D>* mix_grad = c.combined_normal ? mixture_gradient_.data() : nullptr;
       if (rm.kind == BodyMotion::FreeRigid && rm.mass_kg > 0.0) {  // whole-body solve
@@ -568,6 +600,7 @@ class Solver {
   std::vector<double> node_measure_;       ///< per node: h^D (per radian h² r) for the overlap test
   std::vector<double> mixture_volume_;     ///< nodal grains volume when there is no fluid body
   std::vector<Vec<D>> mixture_gradient_;   ///< nodal mixture mass gradient (combined normals)
+  bool mixture_volume_scattered_ = false;  ///< mixture_volume_ holds this step's grains volume
   std::vector<ShapeCache<D>> caches_;
   std::vector<std::int64_t> non_finite_kinematics_;  ///< per body, from the last G2P
   std::vector<GridField<G>> fields_;
