@@ -38,13 +38,18 @@ class StressLaw {
   void update_stress(Body<G>& body, double dt_s) {
     const std::int64_t chunks = chunk_count(body);
     std::int64_t bad = kAllFinite;
+    if (uneven_chunks()) {
 #pragma omp parallel for schedule(dynamic, 1) reduction(min : bad)
-    for (std::int64_t c = 0; c < chunks; ++c) bad = std::min(bad, update_chunk(body, dt_s, c));
+      for (std::int64_t c = 0; c < chunks; ++c) bad = std::min(bad, update_chunk(body, dt_s, c));
+    } else {
+#pragma omp parallel for schedule(static) reduction(min : bad)
+      for (std::int64_t c = 0; c < chunks; ++c) bad = std::min(bad, update_chunk(body, dt_s, c));
+    }
     end_update(body, dt_s, bad);
   }
-  /// The update in independent chunks of points, so that the solver runs the chunks of every
-  /// body's law in one parallel loop (Solver::update_stresses: one fork per step, and a thread
-  /// that is done with cheap chunks takes costly ones). The number of chunks of the step;
+  /// The update in independent chunks of points, so that the solver runs every body's law in one
+  /// parallel region (Solver::update_stresses: one fork per step). The number of chunks of the
+  /// step;
   virtual std::int64_t chunk_count(const Body<G>& body) const = 0;
   /// chunk c's update; returns the lowest index of a point of the chunk whose new stress is not
   /// finite, or kAllFinite. Chunks touch only their own points' state.
@@ -52,9 +57,13 @@ class StressLaw {
   /// Once after all chunks, with the lowest such index over the body (a law that stops the run
   /// on it throws here).
   virtual void end_update(Body<G>& body, double dt_s, std::int64_t first_bad) = 0;
-  /// Cost of one point's update relative to a simple law's (the solver starts the costly chunks
-  /// first, so that the cheap ones fill in at the end).
+  /// Cost of one point's update relative to a simple law's (the solver runs the costly bodies'
+  /// chunks first).
   virtual double relative_cost_per_point() const { return 1.0; }
+  /// Whether the chunks' costs vary (the solver hands them out dynamically); otherwise each thread
+  /// takes its static share, the same points it maps in G2P and scatters in P2G (their data stay
+  /// in that core's caches).
+  virtual bool uneven_chunks() const { return false; }
   /// Fastest wave speed [m/s] at the current state (for the stable time step, model.md §6).
   virtual double max_wave_speed(const Body<G>& body) const = 0;
   /// Largest stable Δt [s] of the law's own diffusion on a grid of cell size h (viscous limit

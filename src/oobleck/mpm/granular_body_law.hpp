@@ -92,6 +92,7 @@ class GranularBodyLaw final : public StressLaw<G> {
   }
   /// (a point takes ≈ 10× the fluid's update: the trial, the branch, Newton lanes)
   double relative_cost_per_point() const override { return 10.0; }
+  bool uneven_chunks() const override { return true; }
 
   /// Fastest granular wave: sqrt((K + 4G/3)/(phi rho_s)) at the loosest point (phi >= 0.05 so
   /// isolated surface points do not stall the run; they carry no stress when separated).

@@ -20,7 +20,6 @@
 #include <stdexcept>
 #include <string>
 #include <type_traits>
-#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -555,11 +554,13 @@ class Solver {
     }
   }
 
-  /// Step 8 for every body in one parallel loop over the chunks of all laws
-  /// (StressLaw::update_chunk), the costliest bodies' first, handed out dynamically: one fork per
-  /// step, and the thread that is done with its share of the costly granular chunks early takes
-  /// more of them while the other finishes; the cheap fluid chunks fill in at the end. Each point's
-  /// update is independent of the others, so the results do not depend on the schedule.
+  /// Step 8 for every body in one parallel region (one fork per step): the bodies with costly,
+  /// uneven chunks first (the granular law, handed out dynamically), then the others, each thread
+  /// its static share — the points it maps in G2P and scatters in P2G, whose data stay in its
+  /// core's caches (handing the fluid's chunks out dynamically as well made the next P2G and G2P
+  /// 5–14% slower on two threads). No barrier between the bodies: a thread done with the granular
+  /// chunks goes on to its share of the next body. Each point's update is independent of the
+  /// others, so the results do not depend on the schedule.
   void update_stresses() {
     const int nb = static_cast<int>(bodies_.size());
     law_bodies_.clear();
@@ -568,21 +569,26 @@ class Solver {
     std::stable_sort(law_bodies_.begin(), law_bodies_.end(), [&](int a, int b) {
       return bodies_[a]->law->relative_cost_per_point() > bodies_[b]->law->relative_cost_per_point();
     });
-    law_chunks_.clear();
-    for (int b : law_bodies_) {
-      const std::int64_t chunks = bodies_[b]->law->chunk_count(*bodies_[b]);
-      for (std::int64_t c = 0; c < chunks; ++c) law_chunks_.emplace_back(b, c);
-    }
     law_first_bad_.assign(bodies_.size(), kAllFinite);
-    const auto items = static_cast<std::int64_t>(law_chunks_.size());
     const double dt = opt_.dt_s;
-#pragma omp parallel for schedule(dynamic, 1)
-    for (std::int64_t k = 0; k < items; ++k) {
-      const auto [b, c] = law_chunks_[static_cast<std::size_t>(k)];
-      const std::int64_t bad = bodies_[b]->law->update_chunk(*bodies_[b], dt, c);
-      if (bad != kAllFinite) {
+#pragma omp parallel
+    {
+      for (int b : law_bodies_) {
+        Body<G>& body = *bodies_[b];
+        StressLaw<G>& law = *body.law;
+        const std::int64_t chunks = law.chunk_count(body);
+        std::int64_t bad = kAllFinite;
+        if (law.uneven_chunks()) {
+#pragma omp for schedule(dynamic, 1) nowait
+          for (std::int64_t c = 0; c < chunks; ++c) bad = std::min(bad, law.update_chunk(body, dt, c));
+        } else {
+#pragma omp for schedule(static) nowait
+          for (std::int64_t c = 0; c < chunks; ++c) bad = std::min(bad, law.update_chunk(body, dt, c));
+        }
+        if (bad != kAllFinite) {
 #pragma omp critical(oobleck_law_first_bad)
-        law_first_bad_[b] = std::min(law_first_bad_[b], bad);
+          law_first_bad_[b] = std::min(law_first_bad_[b], bad);
+        }
       }
     }
     for (int b = 0; b < nb; ++b)  // (in body order, as the laws were run before)
@@ -610,10 +616,9 @@ class Solver {
   std::vector<GridField<G>*> solids_;  ///< scratch of update_grid_and_couple (refilled per call): deformable solids' fields
   std::vector<double> porosity_;  ///< nodal porosity n_i of the mixture
   std::vector<Vec<NC>> flux_;     ///< nodal mixture volume flux q_i
-  // scratch of update_stresses (refilled per call): bodies with a law, costliest first; the
-  // (body, chunk) work items; per body the lowest index of a non-finite result
+  // scratch of update_stresses (refilled per call): bodies with a law, costliest first; per body
+  // the lowest index of a non-finite result
   std::vector<int> law_bodies_;
-  std::vector<std::pair<int, std::int64_t>> law_chunks_;
   std::vector<std::int64_t> law_first_bad_;
   double time_s_ = 0.0;
   std::int64_t steps_ = 0;

@@ -424,13 +424,10 @@ std::int64_t grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& c
   std::int64_t bad = kAllFinite;
   // Points in blocks of numerics::kMathBlock: the per-point work, then the block's volume update
   // V ← V exp(Δt tr L) (step 7) with the exponentials in vector lanes (numerics/vector_math.hpp)
-  // and the NaN guard. The blocks are handed out dynamically (4 at a time): each point is
-  // independent, so the results do not depend on the schedule, and a thread that runs slower in
-  // this pass (which one varies on a shared host) no longer holds the other at the barrier (wheel
-  // set-up on 2 threads: the threads' waits 11% -> 8.5% of the samples).
+  // and the NaN guard.
   constexpr int kBlock = numerics::kMathBlock;
   const std::int64_t blocks = (np + kBlock - 1) / kBlock;
-#pragma omp parallel for schedule(dynamic, 4) reduction(min : bad)
+#pragma omp parallel for schedule(static) reduction(min : bad)
   for (std::int64_t blk = 0; blk < blocks; ++blk) {
     const std::int64_t p0 = blk * kBlock;
     const int nb = static_cast<int>(std::min<std::int64_t>(kBlock, np - p0));
