@@ -60,7 +60,8 @@ class StressLaw {
   /// Cost of one point's update relative to a simple law's (the solver runs the costly bodies'
   /// chunks first).
   virtual double relative_cost_per_point() const { return 1.0; }
-  /// Whether the chunks' costs vary (the solver hands them out dynamically); otherwise each thread
+  /// Whether the chunks' costs vary (the threads then steal each other's remaining chunks at the
+  /// end of their static shares); otherwise each thread
   /// takes its static share, the same points it maps in G2P and scatters in P2G (their data stay
   /// in that core's caches).
   virtual bool uneven_chunks() const { return false; }

@@ -46,8 +46,9 @@ class GranularBodyLaw final : public StressLaw<G> {
 
   // Chunks of kChunk points: the cost per point ranges from a closed form to tens of Newton steps
   // and an implicit structure solve, and it is clustered in space (points are stored by region),
-  // so the chunks are handed out dynamically (Solver::update_stresses; a static split left one
-  // thread waiting: rod impact, 1.3x faster stress pass on 2 threads). Each point is
+  // so the threads steal each other's remaining chunks (uneven_chunks, Solver::update_stresses; a
+  // plain static split left one thread waiting: rod impact, 1.3x faster stress pass on 2 threads
+  // with a dynamic schedule, which stealing keeps while a point stays with its thread). Each point is
   // independent: the results do not depend on the schedule. Within a chunk the law runs its
   // Newton iterations in lanes across points (GranularLaw::advance_batch).
   std::int64_t chunk_count(const Body<G>& body) const override { return (body.size() + kChunk - 1) / kChunk; }
