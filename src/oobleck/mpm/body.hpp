@@ -61,9 +61,9 @@ class StressLaw {
   /// chunks first).
   virtual double relative_cost_per_point() const { return 1.0; }
   /// Whether the chunks' costs vary (the threads then steal each other's remaining chunks at the
-  /// end of their static shares); otherwise each thread
-  /// takes its static share, the same points it maps in G2P and scatters in P2G (their data stay
-  /// in that core's caches).
+  /// end of their static shares); otherwise each thread takes only its static share. A static
+  /// share holds the points the thread maps in G2P and scatters in P2G, so their data stay in that
+  /// core's caches.
   virtual bool uneven_chunks() const { return false; }
   /// Fastest wave speed [m/s] at the current state (for the stable time step, model.md §6).
   virtual double max_wave_speed(const Body<G>& body) const = 0;
