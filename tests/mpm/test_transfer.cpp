@@ -376,10 +376,11 @@ TEST(Transfer, AxisymmetricWithoutSwirlEqualsTheGeneralKernelsBitForBit) {
       // Both kernels compiled here (the library's own instance may be built for another CPU level,
       // with other contractions).
       auto both = [&]<bool A, bool Mix>() {
-        const std::int64_t r1 =
-            detail::grid_to_particles_kernel<G, K, A, false, Mix, true>(b1, cache, field, st.grid, 0.95, 1e-3, n, q);
-        const std::int64_t r2 =
-            detail::grid_to_particles_kernel<G, K, A, false, Mix, false>(b2, cache, field, st.grid, 0.95, 1e-3, n, q);
+        const std::int64_t blocks = (b.size() + oobleck::numerics::kMathBlock - 1) / oobleck::numerics::kMathBlock;
+        const G2PArgs<G> a1{&b1, &cache, &field, &st.grid, 0.95, 1e-3, n, q};
+        const G2PArgs<G> a2{&b2, &cache, &field, &st.grid, 0.95, 1e-3, n, q};
+        const std::int64_t r1 = detail::grid_to_particles_kernel<G, K, A, false, Mix, true>(a1, 0, blocks);
+        const std::int64_t r2 = detail::grid_to_particles_kernel<G, K, A, false, Mix, false>(a2, 0, blocks);
         return std::min(r1, r2);  // (kAllFinite only if both are)
       };
       std::int64_t bad = 0;
@@ -404,4 +405,84 @@ TEST(Transfer, AxisymmetricWithoutSwirlEqualsTheGeneralKernelsBitForBit) {
         EXPECT_TRUE(same(b1.div_q_1_s.data(), b2.div_q_1_s.data(), np));
       }
     }
+}
+
+namespace {
+
+// The solver runs G2P's blocks in static shares with stealing, several bodies in one parallel
+// region (Solver::update_points): a block's result must not depend on which blocks ran before
+// it, or on which thread runs it.
+template <class G>
+void check_g2p_blocks_in_any_order() {
+  constexpr int NC = G::ncomp, K = 9;
+  const QuadraticBSplineKernel kernel{};
+  for (Transfer t : {Transfer::Apic, Transfer::FlipPicBlend}) {
+    SCOPED_TRACE(::testing::Message() << "apic " << (t == Transfer::Apic));
+    ::Setup<G> s1(41u), s2(41u);  // the same points twice
+    const int nn = s1.grid.node_count();
+    GridField<G> field;
+    field.resize(nn, 1);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> s(-1.0, 1.0);
+    std::vector<double> porosity(nn);
+    std::vector<Vec<NC>> flux(nn);
+    for (int i = 0; i < nn; ++i)
+      for (int c = 0; c < NC; ++c) {
+        field.velocity[i][c] = s(rng);
+        field.velocity_old[i][c] = s(rng);
+        flux[i][c] = s(rng);
+        porosity[i] = 0.5 + 0.2 * s(rng);
+      }
+    for (Body<G>* b : {&s1.body, &s2.body}) {
+      b->phi.assign(b->x_m.size(), 0.0);
+      b->div_q_1_s.assign(b->x_m.size(), 0.0);
+    }
+    ShapeCache<G::dim> cache;
+    ASSERT_EQ(compute_shape_cache(s1.grid, kernel, s1.body.x_m, cache), 0);
+    // A point whose velocity turns NaN: the guard must name the lowest such index whatever the
+    // order of the blocks (two bad points, in different blocks).
+    const std::int64_t bad_lo = 70, bad_hi = 250;
+    for (Body<G>* b : {&s1.body, &s2.body}) {
+      b->v_m_s[bad_hi][0] = std::nan("");
+      b->v_m_s[bad_lo][0] = std::nan("");
+    }
+    const std::int64_t whole = grid_to_particles<G, K>(s1.body, cache, field, s1.grid, t, 0.95, 1e-3,
+                                                       porosity.data(), flux.data());
+    const G2PTask<G> task = make_g2p_task<G, K>(s2.body, cache, field, s2.grid, t, 0.95, 1e-3,
+                                                porosity.data(), flux.data());
+    ASSERT_EQ(task.blocks, (s2.body.size() + oobleck::numerics::kMathBlock - 1) / oobleck::numerics::kMathBlock);
+    ASSERT_GE(task.blocks, 3);
+    std::int64_t bad = kAllFinite;
+    // Backwards, in ranges of 1 and 2 blocks.
+    for (std::int64_t b1 = task.blocks; b1 > 0;) {
+      const std::int64_t b0 = std::max<std::int64_t>(0, b1 - (b1 % 2 == 0 ? 2 : 1));
+      bad = std::min(bad, task.run(b0, b1));
+      b1 = b0;
+    }
+    if (t == Transfer::FlipPicBlend) {  // (APIC does not read the old velocity)
+      EXPECT_EQ(whole, bad_lo);
+      EXPECT_EQ(bad, bad_lo);
+    } else {
+      EXPECT_EQ(whole, kAllFinite);
+      EXPECT_EQ(bad, kAllFinite);
+    }
+    const auto np = static_cast<std::size_t>(s1.body.size());
+    auto same = [](const double* x, const double* y, std::size_t count) {
+      return std::memcmp(x, y, count * sizeof(double)) == 0;
+    };
+    EXPECT_TRUE(same(s1.body.x_m.data()->data(), s2.body.x_m.data()->data(), G::dim * np));
+    EXPECT_TRUE(same(s1.body.v_m_s.data()->data(), s2.body.v_m_s.data()->data(), NC * np));
+    EXPECT_TRUE(same(s1.body.C_1_s.data()->data(), s2.body.C_1_s.data()->data(), G::dim * NC * np));
+    EXPECT_TRUE(same(s1.body.L_1_s.data()->data(), s2.body.L_1_s.data()->data(), 9 * np));
+    EXPECT_TRUE(same(s1.body.volume_m3.data(), s2.body.volume_m3.data(), np));
+    EXPECT_TRUE(same(s1.body.phi.data(), s2.body.phi.data(), np));
+    EXPECT_TRUE(same(s1.body.div_q_1_s.data(), s2.body.div_q_1_s.data(), np));
+  }
+}
+
+}  // namespace
+
+TEST(Transfer, G2PBlocksInAnyOrderEqualTheWholeBodyG2P) {
+  check_g2p_blocks_in_any_order<PlaneStrain>();
+  check_g2p_blocks_in_any_order<Axisymmetric>();
 }

@@ -48,7 +48,7 @@ class StressLaw {
     end_update(body, dt_s, bad);
   }
   /// The update in independent chunks of points, so that the solver runs every body's law in one
-  /// parallel region (Solver::update_stresses: one fork per step). The number of chunks of the
+  /// parallel region (Solver::update_points: one fork per step). The number of chunks of the
   /// step;
   virtual std::int64_t chunk_count(const Body<G>& body) const = 0;
   /// chunk c's update; returns the lowest index of a point of the chunk whose new stress is not

@@ -46,7 +46,7 @@ class GranularBodyLaw final : public StressLaw<G> {
 
   // Chunks of kChunk points: the cost per point ranges from a closed form to tens of Newton steps
   // and an implicit structure solve, and it is clustered in space (points are stored by region),
-  // so the threads steal each other's remaining chunks (uneven_chunks, Solver::update_stresses; a
+  // so the threads steal each other's remaining chunks (uneven_chunks, Solver::update_points; a
   // plain static split left one thread waiting: rod impact, 1.3x faster stress pass on 2 threads
   // with a dynamic schedule, which stealing keeps while a point stays with its thread). Each point is
   // independent: the results do not depend on the schedule. Within a chunk the law runs its

@@ -245,10 +245,8 @@ class Solver {
       apply_boundary_conditions_all();     // 4b. walls on nodal velocities, ghost images
       compute_mixture_flux();              //     q_i = (1−n_i) v^s_i + n_i v^f_i for E27
       clock.lap(timings_.grid);
-      grid_to_particles_all<K>();          // 6–7. x, v (FLIP/PIC or APIC), L, V ← V exp(Δt tr L)
-      clock.lap(timings_.g2p);
-      update_stresses();                   // 8. laws
-      clock.lap(timings_.stress);
+      update_points<K>(clock);             // 6–7. x, v (FLIP/PIC or APIC), L, V ← V exp(Δt tr L);
+                                           // 8. laws (one parallel region; laps g2p and stress)
     });
     time_s_ += opt_.dt_s;
     ++steps_;
@@ -537,33 +535,42 @@ class Solver {
     for (auto& f : fields_) apply_boundary_conditions<G>(grid_, bc_, f, opt_.dt_s);
   }
 
+  /// Steps 6–8 for every body in one parallel region (one fork per step, one barrier between G2P
+  /// and the laws).
+  ///
+  /// G2P (6–7): the deformable bodies one after the other with no barrier between them, each
+  /// thread first its static share of the body's blocks — the split of P2G's scatter, the points
+  /// whose data are in its core's caches — then what is left of the other threads' shares
+  /// (stealing: a slower core's points move to the other only at the end of its share).
+  /// Rigid bodies' points move with their body, before the region.
+  ///
+  /// The laws (8): the bodies with costly, uneven chunks first (the granular law) in static shares
+  /// with stealing, then the others (the fluid's, an elastic body's) in static shares: the points
+  /// each thread maps in G2P and scatters in P2G (handing the fluid's chunks out dynamically made
+  /// the next P2G and G2P 5–14% slower on two threads). No barrier between the bodies.
+  ///
+  /// Every point's update is independent of the others: the results do not depend on the
+  /// schedule (bit for bit the same on any number of threads as a serial run of the same code).
   template <int K>
-  void grid_to_particles_all() {
+  void update_points(StepClock& clock) {
     static_assert(!std::is_same_v<G, Axisymmetric> || K == 4 || K == 9 || K == 16,
                   "a new kernel support: add its axisymmetric G2P to transfer_axisymmetric.cpp");
-    non_finite_kinematics_.resize(bodies_.size());
-    for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    const int nb = static_cast<int>(bodies_.size());
+    non_finite_kinematics_.assign(bodies_.size(), kAllFinite);
+    g2p_tasks_.clear();
+    g2p_bodies_.clear();
+    for (int b = 0; b < nb; ++b) {
       if (rigid_[b].rigid()) {
         move_rigid_points(*bodies_[b], rigid_[b], grid_, opt_.dt_s);
         non_finite_kinematics_[b] = kNotChecked;
       } else {
-        non_finite_kinematics_[b] = grid_to_particles<G, K>(
-            *bodies_[b], caches_[b], fields_[b], grid_, opt_.transfer, opt_.flip_fraction, opt_.dt_s,
-            static_cast<int>(b) == fluid_ ? porosity_.data() : nullptr,
-            static_cast<int>(b) == fluid_ ? flux_.data() : nullptr);
+        g2p_tasks_.push_back(make_g2p_task<G, K>(*bodies_[b], caches_[b], fields_[b], grid_, opt_.transfer,
+                                                 opt_.flip_fraction, opt_.dt_s,
+                                                 b == fluid_ ? porosity_.data() : nullptr,
+                                                 b == fluid_ ? flux_.data() : nullptr));
+        g2p_bodies_.push_back(b);
       }
     }
-  }
-
-  /// Step 8 for every body in one parallel region (one fork per step): the bodies with costly,
-  /// uneven chunks first (the granular law: each thread its static share, then what is left of
-  /// the others' shares), then the others, each thread its static share — the points it maps in G2P and scatters in P2G, whose data stay in its
-  /// core's caches (handing the fluid's chunks out dynamically as well made the next P2G and G2P
-  /// 5–14% slower on two threads). No barrier between the bodies: a thread done with the granular
-  /// chunks goes on to its share of the next body. Each point's update is independent of the
-  /// others, so the results do not depend on the schedule.
-  void update_stresses() {
-    const int nb = static_cast<int>(bodies_.size());
     law_bodies_.clear();
     for (int b = 0; b < nb; ++b)
       if (bodies_[b]->law) law_bodies_.push_back(b);
@@ -572,37 +579,69 @@ class Solver {
     });
     law_first_bad_.assign(bodies_.size(), kAllFinite);
     const double dt = opt_.dt_s;
+    const int ntasks = static_cast<int>(g2p_tasks_.size());
 #pragma omp parallel
     {
-      for (int b : law_bodies_) {
+      const int team = omp_get_num_threads(), t = omp_get_thread_num();
+      // Counters of the shares: per G2P task, then per law body (those with uneven chunks), one
+      // per thread's share, each on its own cache line.
+      const int counter_sets = ntasks + static_cast<int>(law_bodies_.size());
+      auto share_begin = [team](std::int64_t n, int u) {  // the split of schedule(static)
+        const std::int64_t q = n / team, r = n % team;
+        return u * q + std::min<std::int64_t>(u, r);
+      };
+#pragma omp single
+      {
+        const std::size_t need = static_cast<std::size_t>(counter_sets) * team;
+        if (share_next_.size() < need) share_next_ = std::vector<ShareCounter>(need);
+        for (int k = 0; k < ntasks; ++k)
+          for (int u = 0; u < team; ++u)
+            share_next_[k * team + u].next.store(share_begin(g2p_tasks_[k].blocks, u), std::memory_order_relaxed);
+        for (std::size_t k = 0; k < law_bodies_.size(); ++k) {
+          Body<G>& body = *bodies_[law_bodies_[k]];
+          const std::int64_t chunks = body.law->chunk_count(body);
+          for (int u = 0; u < team; ++u)
+            share_next_[(ntasks + k) * team + u].next.store(share_begin(chunks, u), std::memory_order_relaxed);
+        }
+      }  // (the barrier: every counter is set)
+      // Static shares with stealing over n units in steps of `grain`: each thread runs its own
+      // share from the front, then the remaining units of the others' shares. Every unit is taken
+      // once (one counter per share).
+      auto run_shares = [&](int set, std::int64_t n, std::int64_t grain, auto&& body_of_units) {
+        for (int k = 0; k < team; ++k) {
+          const int u = (t + k) % team;
+          const std::int64_t end = share_begin(n, u + 1);
+          std::atomic<std::int64_t>& next = share_next_[set * team + u].next;
+          for (;;) {
+            const std::int64_t c = next.fetch_add(grain, std::memory_order_relaxed);
+            if (c >= end) break;
+            body_of_units(c, std::min(c + grain, end));
+          }
+        }
+      };
+      for (int k = 0; k < ntasks; ++k) {
+        const G2PTask<G>& task = g2p_tasks_[k];
+        std::int64_t bad = kAllFinite;
+        run_shares(k, task.blocks, kG2PStealBlocks,
+                   [&](std::int64_t b0, std::int64_t b1) { bad = std::min(bad, task.run(b0, b1)); });
+        if (bad != kAllFinite) {
+#pragma omp critical(oobleck_g2p_first_bad)
+          non_finite_kinematics_[g2p_bodies_[k]] = std::min(non_finite_kinematics_[g2p_bodies_[k]], bad);
+        }
+      }
+#pragma omp barrier
+#pragma omp master
+      clock.lap(timings_.g2p);
+      for (std::size_t k = 0; k < law_bodies_.size(); ++k) {
+        const int b = law_bodies_[k];
         Body<G>& body = *bodies_[b];
         StressLaw<G>& law = *body.law;
         const std::int64_t chunks = law.chunk_count(body);
         std::int64_t bad = kAllFinite;
         if (law.uneven_chunks()) {
-          // Static shares with stealing: each thread runs its own share of the chunks (the split
-          // of schedule(static), the points it maps and scatters) from the front, then takes the
-          // remaining chunks of the others' shares. Every chunk is taken once (one counter per
-          // share); a point's data stay with its thread unless its chunk is stolen.
-          const int team = omp_get_num_threads(), t = omp_get_thread_num();
-          auto share_begin = [&](int u) {
-            const std::int64_t q = chunks / team, r = chunks % team;
-            return u * q + std::min<std::int64_t>(u, r);
-          };
-#pragma omp single
-          {
-            if (static_cast<int>(law_share_next_.size()) < team) law_share_next_ = std::vector<ShareCounter>(team);
-            for (int u = 0; u < team; ++u) law_share_next_[u].next.store(share_begin(u), std::memory_order_relaxed);
-          }  // (the barrier: every counter is set)
-          for (int k = 0; k < team; ++k) {
-            const int u = (t + k) % team;
-            const std::int64_t end = share_begin(u + 1);
-            for (;;) {
-              const std::int64_t c = law_share_next_[u].next.fetch_add(1, std::memory_order_relaxed);
-              if (c >= end) break;
-              bad = std::min(bad, law.update_chunk(body, dt, c));
-            }
-          }
+          run_shares(ntasks + static_cast<int>(k), chunks, 1, [&](std::int64_t c0, std::int64_t) {
+            bad = std::min(bad, law.update_chunk(body, dt, c0));
+          });
         } else {
 #pragma omp for schedule(static) nowait
           for (std::int64_t c = 0; c < chunks; ++c) bad = std::min(bad, law.update_chunk(body, dt, c));
@@ -615,6 +654,7 @@ class Solver {
     }
     for (int b = 0; b < nb; ++b)  // (in body order, as the laws were run before)
       if (bodies_[b]->law) bodies_[b]->law->end_update(*bodies_[b], dt, law_first_bad_[b]);
+    clock.lap(timings_.stress);
   }
 
   Grid<D> grid_;
@@ -638,14 +678,19 @@ class Solver {
   std::vector<GridField<G>*> solids_;  ///< scratch of update_grid_and_couple (refilled per call): deformable solids' fields
   std::vector<double> porosity_;  ///< nodal porosity n_i of the mixture
   std::vector<Vec<NC>> flux_;     ///< nodal mixture volume flux q_i
-  // scratch of update_stresses (refilled per call): bodies with a law, costliest first; per body
-  // the lowest index of a non-finite result
+  // scratch of update_points (refilled per call): the G2P tasks of the deformable bodies and
+  // their body indices; bodies with a law, costliest first; per body the lowest index of a
+  // non-finite law result; the counters of the threads' shares
+  std::vector<G2PTask<G>> g2p_tasks_;
+  std::vector<int> g2p_bodies_;
   std::vector<int> law_bodies_;
   std::vector<std::int64_t> law_first_bad_;
-  struct alignas(64) ShareCounter {  ///< next chunk of one thread's share (own cache line)
+  struct alignas(64) ShareCounter {  ///< next unit of one thread's share (own cache line)
     std::atomic<std::int64_t> next{0};
   };
-  std::vector<ShareCounter> law_share_next_;
+  std::vector<ShareCounter> share_next_;
+  /// G2P blocks taken at a time from a share (4 × 32 points).
+  static constexpr std::int64_t kG2PStealBlocks = 4;
   double time_s_ = 0.0;
   std::int64_t steps_ = 0;
 };

@@ -394,6 +394,31 @@ void update_grid_velocity(GridField<G>& field, double dt_s) {
   }
 }
 
+/// What G2P of one body reads and writes (see grid_to_particles).
+template <class G>
+struct G2PArgs {
+  Body<G>* body = nullptr;
+  const ShapeCache<G::dim>* cache = nullptr;
+  const GridField<G>* field = nullptr;
+  const Grid<G::dim>* grid = nullptr;
+  double alpha = 1.0;  ///< FLIP fraction (FLIP/PIC blend only)
+  double dt_s = 0.0;
+  const double* porosity = nullptr;              ///< n_i (the mixture's fluid only)
+  const Vec<G::ncomp>* mixture_flux = nullptr;   ///< q_i (the mixture's fluid only)
+};
+
+/// G2P of one body as independent blocks of numerics::kMathBlock points, its kernel chosen once
+/// (make_g2p_task): a caller runs the blocks in any order and on any thread (each point's update
+/// reads only the grid and the point itself), e.g. several bodies in one parallel region.
+template <class G>
+struct G2PTask {
+  G2PArgs<G> args;
+  std::int64_t (*kernel)(const G2PArgs<G>&, std::int64_t, std::int64_t) = nullptr;
+  std::int64_t blocks = 0;  ///< ⌈points / kMathBlock⌉
+  /// Blocks [b0, b1): the lowest index of a point whose new x, v or V is not finite, or kAllFinite.
+  std::int64_t run(std::int64_t b0, std::int64_t b1) const { return kernel(args, b0, b1); }
+};
+
 namespace detail {
 
 /// G2P for one body with the per-point branches resolved at compile time (APIC or FLIP/PIC,
@@ -404,13 +429,21 @@ namespace detail {
 /// NoSwirl (axisymmetric only): the body's nodal θ velocities (new and old) and, for the mixture,
 /// the θ flux are all zero, so every θ sum over the nodes is +0 (they start at +0): the sums are
 /// left out and stay +0, the same values.
+/// The blocks [block_begin, block_end) of numerics::kMathBlock points (called by G2PTask::run; not
+/// parallel itself).
 template <class G, int K, bool Apic, bool ByGrad, bool Mixture, bool NoSwirl = false>
-std::int64_t grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& cache, const GridField<G>& field,
-                              const Grid<G::dim>& grid, double alpha, double dt_s, const double* porosity,
-                              const Vec<G::ncomp>* mixture_flux) {
+std::int64_t grid_to_particles_kernel(const G2PArgs<G>& args, std::int64_t block_begin, std::int64_t block_end) {
   constexpr int D = G::dim, NC = G::ncomp, S = support_of<D>(K);
   static_assert(!NoSwirl || G::has_hoop_terms);
   constexpr bool kTheta = NC == 3 && !NoSwirl;  // the third component's sums over the nodes
+  Body<G>& body = *args.body;
+  const ShapeCache<G::dim>& cache = *args.cache;
+  const GridField<G>& field = *args.field;
+  const Grid<G::dim>& grid = *args.grid;
+  const double alpha = args.alpha, dt_s = args.dt_s;
+  const Vec<G::ncomp>* const mixture_flux = args.mixture_flux;
+  const double* const porosity = args.porosity;
+  (void)porosity;  // (read by the mixture kernels only)
   const std::int64_t np = body.size();
   const double* const inv_D = cache.inv_D.data()->data();
   const double* const vel = field.velocity.data()->data();
@@ -426,9 +459,7 @@ std::int64_t grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& c
   // V ← V exp(Δt tr L) (step 7) with the exponentials in vector lanes (numerics/vector_math.hpp)
   // and the NaN guard.
   constexpr int kBlock = numerics::kMathBlock;
-  const std::int64_t blocks = (np + kBlock - 1) / kBlock;
-#pragma omp parallel for schedule(static) reduction(min : bad)
-  for (std::int64_t blk = 0; blk < blocks; ++blk) {
+  for (std::int64_t blk = block_begin; blk < block_end; ++blk) {
     const std::int64_t p0 = blk * kBlock;
     const int nb = static_cast<int>(std::min<std::int64_t>(kBlock, np - p0));
     // per point: Δt tr L, the new x and v summed (for the guard), exp(Δt tr L)
@@ -693,9 +724,9 @@ std::int64_t grid_to_particles_kernel(Body<G>& body, const ShapeCache<G::dim>& c
 /// Returns the lowest index of a point whose new position, velocity or volume is not finite, or
 /// kAllFinite (the run's NaN guard, fused into this pass).
 template <class G, int K>
-std::int64_t grid_to_particles(Body<G>& body, const ShapeCache<G::dim>& cache, const GridField<G>& field,
-                               const Grid<G::dim>& grid, Transfer transfer, double flip_fraction, double dt_s,
-                               const double* porosity = nullptr, const Vec<G::ncomp>* mixture_flux = nullptr) {
+G2PTask<G> make_g2p_task(Body<G>& body, const ShapeCache<G::dim>& cache, const GridField<G>& field,
+                         const Grid<G::dim>& grid, Transfer transfer, double flip_fraction, double dt_s,
+                         const double* porosity = nullptr, const Vec<G::ncomp>* mixture_flux = nullptr) {
   const bool mix = porosity != nullptr;
   bool no_swirl = false;
   if constexpr (G::has_hoop_terms) {
@@ -706,27 +737,45 @@ std::int64_t grid_to_particles(Body<G>& body, const ShapeCache<G::dim>& cache, c
       no_swirl &= (field.velocity[i][2] == 0.0) & (field.velocity_old[i][2] == 0.0) &
                   (!mix || mixture_flux[i][2] == 0.0);
   }
-  auto run = [&]<bool A, bool BG>() {
-    auto kernel = [&]<bool NS>() {
-      if (mix)
-        return detail::grid_to_particles_kernel<G, K, A, BG, true, NS>(body, cache, field, grid, flip_fraction, dt_s,
-                                                                       porosity, mixture_flux);
-      return detail::grid_to_particles_kernel<G, K, A, BG, false, NS>(body, cache, field, grid, flip_fraction, dt_s,
-                                                                      nullptr, nullptr);
+  G2PTask<G> task;
+  task.args = {&body, &cache, &field, &grid, flip_fraction, dt_s, mix ? porosity : nullptr, mix ? mixture_flux : nullptr};
+  task.blocks = (body.size() + numerics::kMathBlock - 1) / numerics::kMathBlock;
+  auto pick = [&]<bool A, bool BG>() {
+    auto with = [&]<bool NS>() {
+      task.kernel = mix ? &detail::grid_to_particles_kernel<G, K, A, BG, true, NS>
+                        : &detail::grid_to_particles_kernel<G, K, A, BG, false, NS>;
     };
     if constexpr (G::has_hoop_terms)
-      if (no_swirl) return kernel.template operator()<true>();
-    return kernel.template operator()<false>();
+      if (no_swirl) return with.template operator()<true>();
+    with.template operator()<false>();
   };
-  if (transfer != Transfer::Apic) return run.template operator()<false, false>();
-  if (cache.apic_by_gradient) return run.template operator()<true, true>();
-  return run.template operator()<true, false>();
+  if (transfer != Transfer::Apic)
+    pick.template operator()<false, false>();
+  else if (cache.apic_by_gradient)
+    pick.template operator()<true, true>();
+  else
+    pick.template operator()<true, false>();
+  return task;
+}
+
+/// G2P of the whole body, its blocks in a static split over the threads (the split of P2G's
+/// scatter, so a point's data stay in one core's caches).
+template <class G, int K>
+std::int64_t grid_to_particles(Body<G>& body, const ShapeCache<G::dim>& cache, const GridField<G>& field,
+                               const Grid<G::dim>& grid, Transfer transfer, double flip_fraction, double dt_s,
+                               const double* porosity = nullptr, const Vec<G::ncomp>* mixture_flux = nullptr) {
+  const G2PTask<G> task =
+      make_g2p_task<G, K>(body, cache, field, grid, transfer, flip_fraction, dt_s, porosity, mixture_flux);
+  std::int64_t bad = kAllFinite;
+#pragma omp parallel for schedule(static) reduction(min : bad)
+  for (std::int64_t blk = 0; blk < task.blocks; ++blk) bad = std::min(bad, task.run(blk, blk + 1));
+  return bad;
 }
 
 // The axisymmetric G2P is compiled in its own translation unit, transfer_axisymmetric.cpp, with
 // 128-bit auto-vectorisation (see there and docs/mpm.md "Performance"); the other units use it.
 #define OOBLECK_AXISYMMETRIC_G2P(KIND, K)                                                                  \
-  KIND template std::int64_t grid_to_particles<Axisymmetric, K>(                                           \
+  KIND template G2PTask<Axisymmetric> make_g2p_task<Axisymmetric, K>(                                      \
       Body<Axisymmetric>&, const ShapeCache<2>&, const GridField<Axisymmetric>&, const Grid<2>&, Transfer, \
       double, double, const double*, const Vec<3>*);
 OOBLECK_AXISYMMETRIC_G2P(extern, 4)

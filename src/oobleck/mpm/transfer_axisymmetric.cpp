@@ -6,7 +6,7 @@
 // the same time on one and on two threads of an Intel benchmark host (the intruder set-up's G2P,
 // 0.49 → 0.50 s per 1000 steps), while its 128-bit form scaled 1.7–1.9× (0.55 → 0.29–0.33 s).
 // The plane-strain and 3D kernels scale at 256 bits and are faster there, so only this one is
-// narrowed. The solver's grid_to_particles_all asserts that every K it uses is listed here.
+// narrowed. The solver's update_points asserts that every K it uses is listed here.
 #include "oobleck/mpm/transfer.hpp"
 
 namespace oobleck::mpm {
