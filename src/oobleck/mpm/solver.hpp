@@ -243,9 +243,9 @@ class Solver {
                                            // rigid bodies; beside it, contact's mass gradients
       resolve_contacts();                  // 3c. body contact (§8), rigid-body velocities
       apply_boundary_conditions_all();     // 4b. walls on nodal velocities, ghost images
-      compute_mixture_flux();              //     q_i = (1−n_i) v^s_i + n_i v^f_i for E27
       clock.lap(timings_.grid);
-      update_points<K>(clock);             // 6–7. x, v (FLIP/PIC or APIC), L, V ← V exp(Δt tr L);
+      update_points<K>(clock);             // q_i = (1−n_i) v^s_i + n_i v^f_i for E27;
+                                           // 6–7. x, v (FLIP/PIC or APIC), L, V ← V exp(Δt tr L);
                                            // 8. laws (one parallel region; laps g2p and stress)
     });
     time_s_ += opt_.dt_s;
@@ -514,17 +514,34 @@ class Solver {
     }
   }
 
-  void compute_mixture_flux() {
-    if (fluid_ < 0) return;
-    const GridField<G>& s = fields_[grains_ >= 0 ? grains_ : fluid_];  // n = 1 without grains
-    const GridField<G>& f = fields_[fluid_];
-    const int nn = f.nodes();
-    flux_.resize(static_cast<std::size_t>(nn));
-#pragma omp parallel for schedule(static) if (nn >= kParallelMinNodes / 8)  // (the wheel's 12 000 nodes: 0.4% of a two-thread step when serial)
-    for (int i = 0; i < nn; ++i) {
-      const double n = porosity_[i];
-      flux_[i] = (1.0 - n) * s.velocity[i] + n * f.velocity[i];
+  /// The mixture's nodal volume flux q_i = (1 − n_i) v^s_i + n_i v^f_i (E27) over the nodes
+  /// [i0, i1), and (axisymmetric) which of the G2P bodies have θ velocity (or, the fluid, θ flux)
+  /// on these nodes: bit k of the result for g2p_bodies_[k] (g2p_without_swirl, node by node).
+  std::uint64_t mixture_flux_and_swirl(int i0, int i1) {
+    std::uint64_t swirl = 0;
+    if (fluid_ >= 0) {
+      const GridField<G>& s = fields_[grains_ >= 0 ? grains_ : fluid_];  // n = 1 without grains
+      const GridField<G>& f = fields_[fluid_];
+      for (int i = i0; i < i1; ++i) {
+        const double n = porosity_[i];
+        flux_[i] = (1.0 - n) * s.velocity[i] + n * f.velocity[i];
+      }
     }
+    if constexpr (G::has_hoop_terms) {
+      const int nk = std::min<int>(64, static_cast<int>(g2p_bodies_.size()));
+      for (int k = 0; k < nk; ++k) {
+        const int b = g2p_bodies_[k];
+        const GridField<G>& field = fields_[b];
+        bool none = true;
+        for (int i = i0; i < i1; ++i)
+          none &= (field.velocity[i][2] == 0.0) & (field.velocity_old[i][2] == 0.0) &
+                  (b != fluid_ || flux_[i][2] == 0.0);
+        if (!none) swirl |= std::uint64_t{1} << k;
+      }
+      // (bodies past the 64th keep the general kernels: the same values)
+      for (int k = nk; k < static_cast<int>(g2p_bodies_.size()); ++k) swirl |= std::uint64_t{1} << 63;
+    }
+    return swirl;
   }
 
   void fold_wall_images_all() {
@@ -557,17 +574,12 @@ class Solver {
                   "a new kernel support: add its axisymmetric G2P to transfer_axisymmetric.cpp");
     const int nb = static_cast<int>(bodies_.size());
     non_finite_kinematics_.assign(bodies_.size(), kAllFinite);
-    g2p_tasks_.clear();
     g2p_bodies_.clear();
     for (int b = 0; b < nb; ++b) {
       if (rigid_[b].rigid()) {
         move_rigid_points(*bodies_[b], rigid_[b], grid_, opt_.dt_s);
         non_finite_kinematics_[b] = kNotChecked;
       } else {
-        g2p_tasks_.push_back(make_g2p_task<G, K>(*bodies_[b], caches_[b], fields_[b], grid_, opt_.transfer,
-                                                 opt_.flip_fraction, opt_.dt_s,
-                                                 b == fluid_ ? porosity_.data() : nullptr,
-                                                 b == fluid_ ? flux_.data() : nullptr));
         g2p_bodies_.push_back(b);
       }
     }
@@ -579,20 +591,47 @@ class Solver {
     });
     law_first_bad_.assign(bodies_.size(), kAllFinite);
     const double dt = opt_.dt_s;
-    const int ntasks = static_cast<int>(g2p_tasks_.size());
+    const int ntasks = static_cast<int>(g2p_bodies_.size());
+    const int nn = grid_.node_count();
+    if (fluid_ >= 0) flux_.resize(static_cast<std::size_t>(nn));
+    // The pass over the nodes (the flux, the swirl test) runs in parallel on grids of 512 nodes
+    // and more (the intruder's 2200: 0.7% of the samples on the master when serial); smaller
+    // ones on the first thread, the others waiting.
+    const bool node_pass_parallel = nn >= kParallelMinNodes / 64;
+    std::uint64_t swirl = 0;
 #pragma omp parallel
     {
       const int team = omp_get_num_threads(), t = omp_get_thread_num();
-      // Counters of the shares: per G2P task, then per law body (those with uneven chunks), one
-      // per thread's share, each on its own cache line.
-      const int counter_sets = ntasks + static_cast<int>(law_bodies_.size());
       auto share_begin = [team](std::int64_t n, int u) {  // the split of schedule(static)
         const std::int64_t q = n / team, r = n % team;
         return u * q + std::min<std::int64_t>(u, r);
       };
+      {
+        std::uint64_t mine = 0;
+        if (node_pass_parallel)
+          mine = mixture_flux_and_swirl(static_cast<int>(share_begin(nn, t)), static_cast<int>(share_begin(nn, t + 1)));
+        else if (t == 0)
+          mine = mixture_flux_and_swirl(0, nn);
+        if (mine != 0) {
+#pragma omp atomic
+          swirl |= mine;
+        }
+      }
+#pragma omp barrier
+      // The G2P tasks (their kernels chosen by the swirl test) and the counters of the shares: per
+      // G2P task, then per law body (those with uneven chunks), one per thread's share, each on
+      // its own cache line.
 #pragma omp single
       {
-        const std::size_t need = static_cast<std::size_t>(counter_sets) * team;
+        g2p_tasks_.clear();
+        for (int k = 0; k < ntasks; ++k) {
+          const int b = g2p_bodies_[k];
+          g2p_tasks_.push_back(make_g2p_task<G, K>(
+              *bodies_[b], caches_[b], fields_[b], grid_, opt_.transfer, opt_.flip_fraction, opt_.dt_s,
+              b == fluid_ ? porosity_.data() : nullptr, b == fluid_ ? flux_.data() : nullptr,
+              G::has_hoop_terms && (swirl >> std::min(k, 63) & 1u) == 0));
+        }
+        const std::size_t need = static_cast<std::size_t>(ntasks + static_cast<int>(law_bodies_.size())) * team;
         if (share_next_.size() < need) share_next_ = std::vector<ShareCounter>(need);
         for (int k = 0; k < ntasks; ++k)
           for (int u = 0; u < team; ++u)
@@ -603,7 +642,7 @@ class Solver {
           for (int u = 0; u < team; ++u)
             share_next_[(ntasks + k) * team + u].next.store(share_begin(chunks, u), std::memory_order_relaxed);
         }
-      }  // (the barrier: every counter is set)
+      }  // (the barrier: the tasks and every counter are set)
       // Static shares with stealing over n units in steps of `grain`: each thread runs its own
       // share from the front, then the remaining units of the others' shares. Every unit is taken
       // once (one counter per share).

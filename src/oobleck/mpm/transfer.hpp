@@ -12,6 +12,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "oobleck/mpm/body.hpp"
@@ -723,20 +724,32 @@ std::int64_t grid_to_particles_kernel(const G2PArgs<G>& args, std::int64_t block
 ///
 /// Returns the lowest index of a point whose new position, velocity or volume is not finite, or
 /// kAllFinite (the run's NaN guard, fused into this pass).
+/// Whether a body's G2P may take the NoSwirl kernels (axisymmetric only): no θ velocity on any
+/// node, new or old, and for the mixture's fluid (`mixture_flux` given) no θ flux. Those kernels
+/// give the same values as the general ones, only faster.
+template <class G>
+bool g2p_without_swirl(const GridField<G>& field, const Vec<G::ncomp>* mixture_flux) {
+  if constexpr (!G::has_hoop_terms) {
+    return false;
+  } else {
+    const int nn = field.nodes();
+    bool no_swirl = true;
+    for (int i = 0; i < nn; ++i)
+      no_swirl &= (field.velocity[i][2] == 0.0) & (field.velocity_old[i][2] == 0.0) &
+                  (mixture_flux == nullptr || mixture_flux[i][2] == 0.0);
+    return no_swirl;
+  }
+}
+
+/// G2P of one body as a task (see G2PTask). `no_swirl`: the answer of g2p_without_swirl when the
+/// caller has it already (the solver finds it in its pass over the nodes); otherwise scanned here.
 template <class G, int K>
 G2PTask<G> make_g2p_task(Body<G>& body, const ShapeCache<G::dim>& cache, const GridField<G>& field,
                          const Grid<G::dim>& grid, Transfer transfer, double flip_fraction, double dt_s,
-                         const double* porosity = nullptr, const Vec<G::ncomp>* mixture_flux = nullptr) {
+                         const double* porosity = nullptr, const Vec<G::ncomp>* mixture_flux = nullptr,
+                         std::optional<bool> no_swirl_known = std::nullopt) {
   const bool mix = porosity != nullptr;
-  bool no_swirl = false;
-  if constexpr (G::has_hoop_terms) {
-    // No θ velocity on any node (and no θ flux): the NoSwirl kernels (the same values).
-    const int nn = field.nodes();
-    no_swirl = true;
-    for (int i = 0; i < nn; ++i)
-      no_swirl &= (field.velocity[i][2] == 0.0) & (field.velocity_old[i][2] == 0.0) &
-                  (!mix || mixture_flux[i][2] == 0.0);
-  }
+  const bool no_swirl = no_swirl_known ? *no_swirl_known : g2p_without_swirl(field, mix ? mixture_flux : nullptr);
   G2PTask<G> task;
   task.args = {&body, &cache, &field, &grid, flip_fraction, dt_s, mix ? porosity : nullptr, mix ? mixture_flux : nullptr};
   task.blocks = (body.size() + numerics::kMathBlock - 1) / numerics::kMathBlock;
@@ -777,7 +790,7 @@ std::int64_t grid_to_particles(Body<G>& body, const ShapeCache<G::dim>& cache, c
 #define OOBLECK_AXISYMMETRIC_G2P(KIND, K)                                                                  \
   KIND template G2PTask<Axisymmetric> make_g2p_task<Axisymmetric, K>(                                      \
       Body<Axisymmetric>&, const ShapeCache<2>&, const GridField<Axisymmetric>&, const Grid<2>&, Transfer, \
-      double, double, const double*, const Vec<3>*);
+      double, double, const double*, const Vec<3>*, std::optional<bool>);
 OOBLECK_AXISYMMETRIC_G2P(extern, 4)
 OOBLECK_AXISYMMETRIC_G2P(extern, 9)
 OOBLECK_AXISYMMETRIC_G2P(extern, 16)
