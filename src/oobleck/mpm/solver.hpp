@@ -235,9 +235,10 @@ class Solver {
                                            // 3. gravity (in the pass over the nodes that sums
                                            //    the threads' copies; motors later)
       clock.lap(timings_.p2g);
-      fold_wall_images_all();              // 4a. walls: ghost contributions onto mirrors
       prepare_contact_arrays();
-      update_grid_and_couple(              // per node, fused: 3a. porosity n_i, buoyancy split
+      update_grid_and_couple(              // first, per body: 4a. walls: ghost contributions onto
+                                           // mirrors; rigid bodies' predictions; then per node,
+                                           // fused: 3a. porosity n_i, buoyancy split
           [this] { scatter_contact_gradients<K>(); });  // E28, ∇p_0; 5. v = (mv + Δt f)/m with
                                            // all non-drag forces; 3b. semi-implicit E29 drag;
                                            // rigid bodies; beside it, contact's mass gradients
@@ -319,22 +320,29 @@ class Solver {
   ///  * semi-implicit drag (model.md §5): C_i = V_i C_V(φ_i, Re_i) with the predicted velocities,
   ///    F_d = C_i/(1 + Δt C_i (1/m_s + 1/m_f)) Δv; grains −F_d, fluid +F_d.
   ///
+  /// Before the pass over the nodes, body by body (each touches only its own field, so the
+  /// bodies run in parallel): the walls' ghost contributions folded onto their mirrors
+  /// (fold_wall_images, step 4a) and a rigid body's nodal velocities (predict_rigid, which reads
+  /// the folded masses).
+  ///
   /// `side` (contact's scatters) runs on one thread of the pass while the others start on the
   /// nodes; the node blocks are handed out dynamically so that thread joins them when it is done
   /// (each node is independent: the same values whichever thread computes it).
   template <class Side>
   void update_grid_and_couple(Side&& side) {
     const double dt = opt_.dt_s;
+    const int nbodies = body_count();
+    auto fold_and_predict = [&](int b) {
+      fold_wall_images<G>(grid_, bc_, fields_[b]);
+      if (rigid_[b].rigid()) predict_rigid(rigid_[b], *bodies_[b], fields_[b], opt_.gravity_m_s2, dt);
+    };
     // Deformable solids (the wheel): their predictions join the mixture's pass over the nodes
     // below when there is a fluid; otherwise they get their own pass.
     solids_.clear();
-    for (int b = 0; b < body_count(); ++b) {
-      if (rigid_[b].rigid())
-        predict_rigid(rigid_[b], *bodies_[b], fields_[b], opt_.gravity_m_s2, dt);
-      else if (b != grains_ && b != fluid_)
-        solids_.push_back(&fields_[b]);
-    }
+    for (int b = 0; b < nbodies; ++b)
+      if (!rigid_[b].rigid() && b != grains_ && b != fluid_) solids_.push_back(&fields_[b]);
     if (fluid_ < 0) {
+      for (int b = 0; b < nbodies; ++b) fold_and_predict(b);
       side();
       for (GridField<G>* sf : solids_) update_grid_velocity(*sf, dt);
       if (grains_ >= 0) update_grid_velocity(fields_[grains_], dt);
@@ -353,6 +361,8 @@ class Solver {
     const int blocks = (nn + kBlock - 1) / kBlock;
 #pragma omp parallel if (nn >= kParallelMinNodes / 32)  // ~20 ns per node (drag)
     {
+#pragma omp for schedule(dynamic, 1)
+      for (int b = 0; b < nbodies; ++b) fold_and_predict(b);
 #pragma omp single nowait
       side();
 #pragma omp for schedule(dynamic, 4) nowait
@@ -542,10 +552,6 @@ class Solver {
       for (int k = nk; k < static_cast<int>(g2p_bodies_.size()); ++k) swirl |= std::uint64_t{1} << 63;
     }
     return swirl;
-  }
-
-  void fold_wall_images_all() {
-    for (auto& f : fields_) fold_wall_images<G>(grid_, bc_, f);
   }
 
   void apply_boundary_conditions_all() {
