@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "oobleck/core/error.hpp"
 #include "oobleck/mpm/laws.hpp"
 #include "oobleck/mpm/solver.hpp"
 
@@ -152,5 +153,39 @@ TEST(Conservation, ThreeDimensionalSpinningBlock) {
     EXPECT_EQ(b.total_mass(), m0);
     EXPECT_LT((b.total_momentum() - P0).norm(), 1e-13 * m0);
     EXPECT_LT((ang() - L0).norm(), 1e-12 * L0.norm()) << static_cast<int>(k);
+  }
+}
+
+// A point more than one cell outside the domain stops the step with the body's name, the count of
+// such points (summed over the threads' shares and over the bodies' scatters) and the step; a body
+// with every point inside is not named.
+TEST(Conservation, PointsOutsideTheGridStopTheStepWithTheBodyNamed) {
+  for (int threads : {1, 2}) {
+    SCOPED_TRACE(::testing::Message() << "threads " << threads);
+    const double h = 0.05;
+    Grid<2> grid(Vec<2>(-1.0, -1.0), h, {40, 40});
+    SolverOptions<PlaneStrain> opt;
+    opt.threads = threads;
+    LinearElasticParams ep;
+    ep.youngs_modulus_Pa = 1e5;
+    ep.poisson_ratio = 0.3;
+    opt.dt_s = 1e-4;
+    Solver<PlaneStrain> s(grid, opt);
+    auto& inside = s.add_body("inside");
+    auto& lost = s.add_body("lost");
+    for (Body<PlaneStrain>* b : {&inside, &lost}) {
+      b->set_law(std::make_unique<LinearElasticLaw<PlaneStrain>>(ep));
+      for (int i = 0; i < 100; ++i) b->add_point(Vec<2>(-0.5 + 0.01 * i, 0.0), h * h / 4.0, 1000.0);
+    }
+    // Three points of the second body (one in each thread's half) 3 cells beyond the right face.
+    for (std::int64_t p : {5, 60, 99}) lost.x_m[p] = Vec<2>(1.0 + 3.0 * h, 0.1);
+    try {
+      s.step();
+      FAIL() << "no error";
+    } catch (const oobleck::NumericalError& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("3 point(s) of body 'lost' left the grid"), std::string::npos) << m;
+      EXPECT_NE(m.find("step 0"), std::string::npos) << m;
+    }
   }
 }

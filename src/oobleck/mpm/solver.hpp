@@ -286,26 +286,47 @@ class Solver {
     }
   }
 
-  /// Steps 1–3 for every body: each point's shape functions (into its body's cache), its scatter
-  /// and gravity on the nodal masses (particles_to_grid).
+  /// Steps 1–3 for every body in one parallel region: each point's shape functions (into its
+  /// body's cache), its scatter, and gravity on the nodal masses (particles_to_grid, in its two
+  /// phases). Every thread scatters its static share of each body's points into its copy of that
+  /// body's nodal arrays with no barrier between the bodies; after one barrier, each thread sums
+  /// the copies over its share of the nodes, body after body. The same splits and sums as one
+  /// region per body: the same values.
   template <int K>
   void particles_to_grid_all() {
     omp_set_num_threads(threads_);
     const bool apic = opt_.transfer == Transfer::Apic;
-    for (std::size_t b = 0; b < bodies_.size(); ++b) {
-      const std::int64_t bad = with_kernel(opt_.shape, opt_.gimp_half_width_cells, [&](auto kernel) -> std::int64_t {
-        if constexpr (decltype(kernel)::support == support_of<D>(K))
-          return particles_to_grid<G, K>(*bodies_[b], grid_, kernel, caches_[b], fields_[b], apic,
-                                         static_cast<int>(b) == fluid_, &opt_.gravity_m_s2);
-        else
-          return 0;  // not reached: with_support and with_kernel read the same option
+    const int nb = body_count();
+    auto for_kernel = [&](auto&& f) {
+      with_kernel(opt_.shape, opt_.gimp_half_width_cells, [&](auto kernel) {
+        if constexpr (decltype(kernel)::support == support_of<D>(K)) f(kernel);
+        // (other supports not reached: with_support and with_kernel read the same option)
       });
-      if (bad > 0)
+    };
+    for (int b = 0; b < nb; ++b)
+      for_kernel([&](auto kernel) { detail::p2g_prepare<G, K, decltype(kernel)>(*bodies_[b], caches_[b]); });
+    p2g_outside_.assign(bodies_.size(), 0);
+#pragma omp parallel
+    {
+      for (int b = 0; b < nb; ++b) {
+        for_kernel([&](auto kernel) {
+          const std::int64_t out = detail::p2g_scatter_share<G, K>(*bodies_[b], grid_, kernel, caches_[b], fields_[b],
+                                                                   apic, b == fluid_);
+          if (out > 0) {
+#pragma omp atomic
+            p2g_outside_[b] += out;
+          }
+        });
+      }
+#pragma omp barrier
+      for (int b = 0; b < nb; ++b) detail::p2g_sum_share(fields_[b], b == fluid_, &opt_.gravity_m_s2);
+    }
+    for (int b = 0; b < nb; ++b)
+      if (p2g_outside_[b] > 0)
         throw NumericalError(fmt::format(
             "mpm: {} point(s) of body '{}' left the grid (more than one cell outside the domain) at "
             "step {}, t = {} s",
-            bad, bodies_[b]->name, steps_, time_s_));
-    }
+            p2g_outside_[b], bodies_[b]->name, steps_, time_s_));
   }
 
   bool mixture() const { return grains_ >= 0 && fluid_ >= 0; }
@@ -728,6 +749,7 @@ class Solver {
   // non-finite law result; the counters of the threads' shares
   std::vector<G2PTask<G>> g2p_tasks_;
   std::vector<int> g2p_bodies_;
+  std::vector<std::int64_t> p2g_outside_;  ///< per body: points whose support left the grid (P2G)
   std::vector<int> law_bodies_;
   std::vector<std::int64_t> law_first_bad_;
   struct alignas(64) ShareCounter {  ///< next unit of one thread's share (own cache line)

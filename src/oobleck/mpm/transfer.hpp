@@ -282,6 +282,103 @@ void add_gravity(GridField<G>& field, const Vec<G::ncomp>& g_m_s2) {
   for (int i = 0; i < nn; ++i) field.force_N[i] += field.mass_kg[i] * g_m_s2;
 }
 
+namespace detail {
+
+/// P2G, before its parallel region: the shape cache sized for the body's points.
+template <class G, int K, class Kernel>
+void p2g_prepare(const Body<G>& body, ShapeCache<G::dim>& cache) {
+  constexpr int S = support_of<G::dim>(K);
+  static_assert(Kernel::support == S);
+  cache.reserve(body.size(), S);
+  cache.apic_by_gradient = Kernel::apic_by_gradient;
+}
+
+/// P2G's first phase, called by every thread of an enclosing parallel region (its `omp for` binds
+/// to that region; no barrier at its end): the calling thread zeroes its copy of the nodal arrays
+/// (thread 0: the field's own arrays) and scatters its static share of the points into it.
+/// Returns the number of its points whose support left the stored nodes.
+template <class G, int K, class Kernel>
+std::int64_t p2g_scatter_share(const Body<G>& body, const Grid<G::dim>& grid, const Kernel& kernel,
+                               ShapeCache<G::dim>& cache, GridField<G>& field, bool apic, bool split_pressure) {
+  constexpr int NC = G::ncomp, S = support_of<G::dim>(K);
+  const std::int64_t np = body.size();
+  const int nn = field.nodes();
+  const StencilGrid<G::dim> sg(grid);
+  std::int64_t bad = 0;
+  const int t = omp_get_thread_num();
+  double* m = t == 0 ? field.mass_kg.data() : field.t_mass[t - 1].data();
+  Vec<NC>* mv = t == 0 ? field.momentum.data() : field.t_momentum[t - 1].data();
+  Vec<NC>* f = t == 0 ? field.force_N.data() : field.t_force[t - 1].data();
+  Vec<NC>* fp = t == 0 ? field.pressure_force_N.data() : field.t_pressure[t - 1].data();
+  double* vol = t == 0 ? field.volume_m3.data() : field.t_volume[t - 1].data();
+  for (int i = 0; i < nn; ++i) {
+    m[i] = 0.0;
+    mv[i].setZero();
+    f[i].setZero();
+  }
+  if (split_pressure) {
+    for (int i = 0; i < nn; ++i) {
+      fp[i].setZero();
+      vol[i] = 0.0;
+    }
+  }
+  double* mvd = mv->data();
+  double* fd = f->data();
+  double* fpd = fp->data();
+  auto scatter = [&]<bool A, bool Sp>() {
+#pragma omp for schedule(static) nowait
+    for (std::int64_t p = 0; p < np; ++p) {
+      if (!make_stencil(grid, sg, kernel, body.x_m[p], cache.template stencil<S>(p), cache.inv_D[p])) ++bad;
+      if constexpr (G::has_hoop_terms) {
+        // Beds without swirl (the intruder, the rod) skip the θ terms: the same sums; points
+        // with swirl take the general kernel.
+        if (point_without_swirl(body, p))
+          particles_to_grid_point<G, K, A, Sp, true>(body, cache, p, m, mvd, fd, fpd, vol);
+        else
+          particles_to_grid_point<G, K, A, Sp>(body, cache, p, m, mvd, fd, fpd, vol);
+      } else {
+        // (plane strain and 3D: inlined here)
+        particles_to_grid_point_inlined<G, K, A, Sp>(body, cache, p, m, mvd, fd, fpd, vol);
+      }
+    }
+  };
+  if (apic) {
+    if (split_pressure) scatter.template operator()<true, true>();
+    else scatter.template operator()<true, false>();
+  } else {
+    if (split_pressure) scatter.template operator()<false, true>();
+    else scatter.template operator()<false, false>();
+  }
+  return bad;
+}
+
+/// P2G's second phase, after a barrier that follows every thread's p2g_scatter_share (called by
+/// every thread of the region; no barrier at its end): the copies' sums in thread order over the
+/// calling thread's static share of the nodes, and the body load of step 3 (gravity) on the summed
+/// mass. Each node is summed by one thread, in the same order whichever it is.
+template <class G>
+void p2g_sum_share(GridField<G>& field, bool split_pressure, const Vec<G::ncomp>* gravity_m_s2) {
+  constexpr int NC = G::ncomp;
+  const int nn = field.nodes(), team = omp_get_num_threads();
+  const bool gravity = gravity_m_s2 != nullptr && gravity_m_s2->squaredNorm() != 0.0;
+  const Vec<NC> g = gravity ? *gravity_m_s2 : Vec<NC>::Zero();
+#pragma omp for schedule(static) nowait
+  for (int i = 0; i < nn; ++i) {
+    for (int u = 1; u < team; ++u) {
+      field.mass_kg[i] += field.t_mass[u - 1][i];
+      field.momentum[i] += field.t_momentum[u - 1][i];
+      field.force_N[i] += field.t_force[u - 1][i];
+      if (split_pressure) {
+        field.pressure_force_N[i] += field.t_pressure[u - 1][i];
+        field.volume_m3[i] += field.t_volume[u - 1][i];
+      }
+    }
+    if (gravity) field.force_N[i] += field.mass_kg[i] * g;
+  }
+}
+
+}  // namespace detail
+
 /// P2G (model.md §6 step 2): nodal mass, momentum (with the APIC affine term when `apic`),
 /// internal force f_i = −∑_p V_p σ_p ∇N_ip, and external point loads ∑_p N_ip f_ext,p. K = local nodes per point (support^dim).
 /// With `split_pressure` (the fluid phase) the stress is split as σ = τ − p 1 (p = −tr σ/3): the
@@ -299,81 +396,13 @@ template <class G, int K, class Kernel>
 std::int64_t particles_to_grid(const Body<G>& body, const Grid<G::dim>& grid, const Kernel& kernel,
                                ShapeCache<G::dim>& cache, GridField<G>& field, bool apic, bool split_pressure = false,
                                const Vec<G::ncomp>* gravity_m_s2 = nullptr) {
-  constexpr int NC = G::ncomp, S = support_of<G::dim>(K);
-  static_assert(Kernel::support == S);
-  const std::int64_t np = body.size();
-  const int nn = field.nodes();
-  cache.reserve(np, S);
-  cache.apic_by_gradient = Kernel::apic_by_gradient;
-  const StencilGrid<G::dim> sg(grid);
-  int team = 1;
+  detail::p2g_prepare<G, K, Kernel>(body, cache);
   std::int64_t bad = 0;
-  const bool gravity = gravity_m_s2 != nullptr && gravity_m_s2->squaredNorm() != 0.0;
-  const Vec<NC> g = gravity ? *gravity_m_s2 : Vec<NC>::Zero();
-#pragma omp parallel num_threads(field.max_threads())
+#pragma omp parallel num_threads(field.max_threads()) reduction(+ : bad)
   {
-    const int t = omp_get_thread_num();
-#pragma omp single
-    team = omp_get_num_threads();
-    double* m = t == 0 ? field.mass_kg.data() : field.t_mass[t - 1].data();
-    Vec<NC>* mv = t == 0 ? field.momentum.data() : field.t_momentum[t - 1].data();
-    Vec<NC>* f = t == 0 ? field.force_N.data() : field.t_force[t - 1].data();
-    Vec<NC>* fp = t == 0 ? field.pressure_force_N.data() : field.t_pressure[t - 1].data();
-    double* vol = t == 0 ? field.volume_m3.data() : field.t_volume[t - 1].data();
-    for (int i = 0; i < nn; ++i) {
-      m[i] = 0.0;
-      mv[i].setZero();
-      f[i].setZero();
-    }
-    if (split_pressure) {
-      for (int i = 0; i < nn; ++i) {
-        fp[i].setZero();
-        vol[i] = 0.0;
-      }
-    }
-    double* mvd = mv->data();
-    double* fd = f->data();
-    double* fpd = fp->data();
-    auto scatter = [&]<bool A, bool Sp>() {
-#pragma omp for schedule(static) reduction(+ : bad)
-      for (std::int64_t p = 0; p < np; ++p) {
-        if (!make_stencil(grid, sg, kernel, body.x_m[p], cache.template stencil<S>(p), cache.inv_D[p])) ++bad;
-        if constexpr (G::has_hoop_terms) {
-          // Beds without swirl (the intruder, the rod) skip the θ terms: the same sums; points
-          // with swirl take the general kernel.
-          if (detail::point_without_swirl(body, p))
-            detail::particles_to_grid_point<G, K, A, Sp, true>(body, cache, p, m, mvd, fd, fpd, vol);
-          else
-            detail::particles_to_grid_point<G, K, A, Sp>(body, cache, p, m, mvd, fd, fpd, vol);
-        } else {
-          // (plane strain and 3D: inlined here)
-          detail::particles_to_grid_point_inlined<G, K, A, Sp>(body, cache, p, m, mvd, fd, fpd, vol);
-        }
-      }
-    };
-    if (apic) {
-      if (split_pressure) scatter.template operator()<true, true>();
-      else scatter.template operator()<true, false>();
-    } else {
-      if (split_pressure) scatter.template operator()<false, true>();
-      else scatter.template operator()<false, false>();
-    }
-    // (the scatter loop's barrier: every copy is complete) The copies' sums in thread order, and
-    // the body load of step 3 (gravity) on the summed mass, in the same region (no second
-    // fork; each node is summed by one thread, in the same order whichever it is).
-#pragma omp for schedule(static) nowait
-    for (int i = 0; i < nn; ++i) {
-      for (int u = 1; u < team; ++u) {
-        field.mass_kg[i] += field.t_mass[u - 1][i];
-        field.momentum[i] += field.t_momentum[u - 1][i];
-        field.force_N[i] += field.t_force[u - 1][i];
-        if (split_pressure) {
-          field.pressure_force_N[i] += field.t_pressure[u - 1][i];
-          field.volume_m3[i] += field.t_volume[u - 1][i];
-        }
-      }
-      if (gravity) field.force_N[i] += field.mass_kg[i] * g;
-    }
+    bad += detail::p2g_scatter_share<G, K>(body, grid, kernel, cache, field, apic, split_pressure);
+#pragma omp barrier
+    detail::p2g_sum_share(field, split_pressure, gravity_m_s2);
   }
   return bad;
 }
