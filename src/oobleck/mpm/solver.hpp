@@ -76,7 +76,9 @@ inline int kernel_support(ShapeKind k) {
 
 /// Accumulated wall time [s] per part of the step (where the time goes).
 struct StepTimings {
-  double p2g = 0, grid = 0, g2p = 0, stress = 0;  ///< p2g includes the shape functions (fused)
+  /// p2g includes the shape functions (fused); grid the walls' folding, the grid update, drag and
+  /// contact; g2p the walls' conditions on the velocities, the mixture flux and G2P; stress the laws.
+  double p2g = 0, grid = 0, g2p = 0, stress = 0;
   double total() const { return p2g + grid + g2p + stress; }
 };
 
@@ -243,9 +245,10 @@ class Solver {
                                            // all non-drag forces; 3b. semi-implicit E29 drag;
                                            // rigid bodies; beside it, contact's mass gradients
       resolve_contacts();                  // 3c. body contact (§8), rigid-body velocities
-      apply_boundary_conditions_all();     // 4b. walls on nodal velocities, ghost images
       clock.lap(timings_.grid);
-      update_points<K>(clock);             // q_i = (1−n_i) v^s_i + n_i v^f_i for E27;
+      update_points<K>(clock);             // 4b. walls on nodal velocities, ghost images (the
+                                           // bodies in parallel); q_i = (1−n_i) v^s_i + n_i v^f_i
+                                           // for E27;
                                            // 6–7. x, v (FLIP/PIC or APIC), L, V ← V exp(Δt tr L);
                                            // 8. laws (one parallel region; laps g2p and stress)
     });
@@ -575,12 +578,9 @@ class Solver {
     return swirl;
   }
 
-  void apply_boundary_conditions_all() {
-    for (auto& f : fields_) apply_boundary_conditions<G>(grid_, bc_, f, opt_.dt_s);
-  }
-
-  /// Steps 6–8 for every body in one parallel region (one fork per step, one barrier between G2P
-  /// and the laws).
+  /// Step 4b (the walls' conditions, body by body), the mixture flux and steps 6–8 for every
+  /// body in one parallel region (one fork per step; barriers after the walls, after the flux
+  /// pass, and between G2P and the laws).
   ///
   /// G2P (6–7): the deformable bodies one after the other with no barrier between them, each
   /// thread first its static share of the body's blocks — the split of P2G's scatter, the points
@@ -633,6 +633,10 @@ class Solver {
         const std::int64_t q = n / team, r = n % team;
         return u * q + std::min<std::int64_t>(u, r);
       };
+      // Step 4b, the walls' conditions on every body's nodal velocities (each body its own field:
+      // the bodies in parallel; the barrier: the flux reads the constrained velocities).
+#pragma omp for schedule(dynamic, 1)
+      for (int b = 0; b < nb; ++b) apply_boundary_conditions<G>(grid_, bc_, fields_[b], opt_.dt_s);
       {
         std::uint64_t mine = 0;
         if (node_pass_parallel)
