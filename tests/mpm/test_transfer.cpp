@@ -46,6 +46,27 @@ struct Setup {
   }
 };
 
+// Random nodal velocities (new and old), mixture flux and porosity in [0.4, 0.6] for G2P.
+template <class G>
+struct RandomNodes {
+  static constexpr int NC = G::ncomp;
+  GridField<G> field;
+  std::vector<double> porosity;
+  std::vector<Vec<NC>> flux;
+  explicit RandomNodes(int nn) : porosity(nn), flux(nn) {
+    field.resize(nn, 1);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> s(-1.0, 1.0), u(0.0, 1.0);
+    for (int i = 0; i < nn; ++i)
+      for (int c = 0; c < NC; ++c) {
+        field.velocity[i][c] = s(rng);
+        field.velocity_old[i][c] = s(rng);
+        flux[i][c] = s(rng);
+        porosity[i] = 0.4 + 0.2 * u(rng);
+      }
+  }
+};
+
 double max_abs(double a, double b) { return std::max(std::fabs(a), std::fabs(b)); }
 
 template <class G, class Kernel>
@@ -131,19 +152,10 @@ void check_g2p(const Kernel& kernel, Transfer transfer, bool mixture) {
   Setup<G> st(21u + (mixture ? 1u : 0u));
   auto& b = st.body;
   const int nn = st.grid.node_count();
-  GridField<G> field;
-  field.resize(nn, 1);
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> s(-1.0, 1.0), u(0.0, 1.0);
-  std::vector<double> porosity(nn);
-  std::vector<Vec<NC>> flux(nn);
-  for (int i = 0; i < nn; ++i)
-    for (int c = 0; c < NC; ++c) {
-      field.velocity[i][c] = s(rng);
-      field.velocity_old[i][c] = s(rng);
-      flux[i][c] = s(rng);
-      porosity[i] = 0.4 + 0.2 * u(rng);
-    }
+  RandomNodes<G> rn(nn);
+  GridField<G>& field = rn.field;
+  const std::vector<double>& porosity = rn.porosity;
+  const std::vector<Vec<NC>>& flux = rn.flux;
   if (mixture) {
     b.phi.assign(b.x_m.size(), 0.0);
     b.div_q_1_s.assign(b.x_m.size(), 0.0);
@@ -419,20 +431,10 @@ void check_g2p_blocks_in_any_order() {
   for (Transfer t : {Transfer::Apic, Transfer::FlipPicBlend}) {
     SCOPED_TRACE(::testing::Message() << "apic " << (t == Transfer::Apic));
     ::Setup<G> s1(41u), s2(41u);  // the same points twice
-    const int nn = s1.grid.node_count();
-    GridField<G> field;
-    field.resize(nn, 1);
-    std::mt19937 rng(5);
-    std::uniform_real_distribution<double> s(-1.0, 1.0);
-    std::vector<double> porosity(nn);
-    std::vector<Vec<NC>> flux(nn);
-    for (int i = 0; i < nn; ++i)
-      for (int c = 0; c < NC; ++c) {
-        field.velocity[i][c] = s(rng);
-        field.velocity_old[i][c] = s(rng);
-        flux[i][c] = s(rng);
-        porosity[i] = 0.5 + 0.2 * s(rng);
-      }
+    const RandomNodes<G> rn(s1.grid.node_count());
+    const GridField<G>& field = rn.field;
+    const std::vector<double>& porosity = rn.porosity;
+    const std::vector<Vec<NC>>& flux = rn.flux;
     for (Body<G>* b : {&s1.body, &s2.body}) {
       b->phi.assign(b->x_m.size(), 0.0);
       b->div_q_1_s.assign(b->x_m.size(), 0.0);
