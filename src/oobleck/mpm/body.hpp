@@ -89,7 +89,7 @@ struct Body {
   std::vector<Vec<D>> x_m;          ///< position
   std::vector<Vec<NC>> v_m_s;       ///< velocity
   std::vector<Mat<NC, D>> C_1_s;    ///< APIC affine velocity matrix (ncomp × dim)
-  std::vector<Mat3> L_1_s;          ///< 3×3 velocity gradient of the last step (geometry terms incl.)
+  std::vector<Mat3> L_1_s;          ///< 3×3 velocity gradient of the last step, geometry terms incl. (axisymmetric: relative to the turning local basis, geometry.hpp)
   std::vector<Mat3> stress_Pa;      ///< Cauchy stress, positive in tension
   std::vector<Vec<NC>> f_ext_N;     ///< external force on the point (surface loads), spread by N_ip
   // Mixture fields interpolated from the nodes in G2P (fluid phase of a mixture only):

@@ -3,7 +3,8 @@
 //
 // A geometry policy says how many spatial dimensions the grid has (`dim`) and how many velocity
 // components a point carries (`ncomp`), and supplies the geometry-specific pieces of the step:
-//   velocity_gradient(∑ v_i ∇N_ipᵀ, x_p, v_p)  the 3×3 L (hoop entries in axisymmetric mode),
+//   velocity_gradient(∑ v_i ∇N_ipᵀ, x_p, v_p)  the 3×3 L the laws integrate (axisymmetric: relative
+//                                             to the turning local basis, see Axisymmetric),
 //   measure(x, area)                          point volume from its cross-section (per radian: A r),
 //   and, when has_hoop_terms, the per-point nodal force terms scaled by N_ip:
 //   hoop_force(σ, x, V) and inertial_acceleration(x, v) (centrifugal / Coriolis), and the extra
@@ -65,7 +66,17 @@ struct ThreeD {
 ///   f_r −= σ_θθ V/r,  f_θ += σ_rθ V/r                         (hoop terms)
 ///   f_r += m v_θ²/r,  f_θ −= m v_r v_θ/r                       (centrifugal, Coriolis: the physical
 ///                                                                components' inertial terms)
-/// and L_θθ = v_r/r, L_rθ = −v_θ/r, div q = ∂q_r/∂r + ∂q_z/∂z + q_r/r.
+/// and div q = ∂q_r/∂r + ∂q_z/∂z + q_r/r.
+///
+/// The velocity gradient in the physical (r, z, θ) components has the geometry entries
+/// (∇v)_θθ = v_r/r and (∇v)_rθ = −v_θ/r. The laws integrate their stresses as components in this
+/// local basis, and the basis turns with the point as it moves in θ: at the spin Ω_b with
+/// (Ω_b)_θr = v_θ/r = −(Ω_b)_rθ. The rate of the components is the objective (Jaumann) rate with
+/// the spin W − Ω_b, so L here is the gradient relative to the turning basis, L = ∇v − Ω_b
+/// (docs/equations.md, E16): the same D = sym L, the spin W = skew L − Ω_b, and
+///   L_θθ = v_r/r,  L_rθ = 0,  L_θr = ∂v_θ/∂r − v_θ/r.
+/// A rigid rotation v_θ = ω r has L = 0 and keeps every stress component; without Ω_b it would
+/// turn the stress at the rate ω against its own basis.
 struct Axisymmetric {
   static constexpr int dim = 2;
   static constexpr int ncomp = 3;
@@ -76,17 +87,17 @@ struct Axisymmetric {
     Mat3 L = Mat3::Zero();
     L.leftCols<2>() = grad_v;
     const double ir = 1.0 / x[0];
-    L(0, 2) = -v[2] * ir;
+    L(2, 0) -= v[2] * ir;  // − (Ω_b)_θr
     L(2, 2) = v[0] * ir;
     return L;
   }
   /// velocity_gradient written entry by entry (see PlaneStrain); returns tr L.
   static double write_velocity_gradient(double* L, const double* g0, const double* g1, const Vec<dim>& x,
                                         const double* v) {
-    L[0] = g0[0], L[1] = g0[1], L[2] = g0[2];
-    L[3] = g1[0], L[4] = g1[1], L[5] = g1[2];
     const double ir = 1.0 / x[0];
-    L[6] = -v[2] * ir, L[7] = 0.0, L[8] = v[0] * ir;
+    L[0] = g0[0], L[1] = g0[1], L[2] = g0[2] - v[2] * ir;
+    L[3] = g1[0], L[4] = g1[1], L[5] = g1[2];
+    L[6] = 0.0, L[7] = 0.0, L[8] = v[0] * ir;
     return (L[0] + L[4]) + L[8];
   }
   static Vec<ncomp> hoop_force(const Mat3& sigma, const Vec<dim>& x, double V) {
