@@ -25,6 +25,16 @@ struct Body;
 inline constexpr std::int64_t kAllFinite = std::numeric_limits<std::int64_t>::max();
 inline constexpr std::int64_t kNotChecked = -1;
 
+/// What a law tells the solver's scheduler about its chunks (parallel.hpp).
+struct ScheduleHint {
+  /// Cost of one point's update relative to a simple law's: the costliest bodies' chunks run first.
+  double relative_cost_per_point = 1.0;
+  /// The chunks' costs vary: the threads steal each other's remaining chunks at the end of their
+  /// static shares. Otherwise each thread runs only its static share, which holds the points it
+  /// maps in G2P and scatters in P2G (their data stay in its core's caches).
+  bool uneven_chunks = false;
+};
+
 /// A stress law for a whole body (one virtual call per body per step; the loop over points and the
 /// per-point pure function are inside). Implementations own their per-point state arrays.
 template <class G>
@@ -33,23 +43,9 @@ class StressLaw {
   virtual ~StressLaw() = default;
   /// Called whenever points are added, so the law can size its state (new points get defaults).
   virtual void resize(std::int64_t n_points) = 0;
-  /// Update body.stress from body.L (and the law's state) over one step of length dt [s]: every
-  /// chunk (update_chunk, in parallel), then end_update.
-  void update_stress(Body<G>& body, double dt_s) {
-    const std::int64_t chunks = chunk_count(body);
-    std::int64_t bad = kAllFinite;
-    if (uneven_chunks()) {
-#pragma omp parallel for schedule(dynamic, 1) reduction(min : bad)
-      for (std::int64_t c = 0; c < chunks; ++c) bad = std::min(bad, update_chunk(body, dt_s, c));
-    } else {
-#pragma omp parallel for schedule(static) reduction(min : bad)
-      for (std::int64_t c = 0; c < chunks; ++c) bad = std::min(bad, update_chunk(body, dt_s, c));
-    }
-    end_update(body, dt_s, bad);
-  }
-  /// The update in independent chunks of points, so that the solver runs every body's law in one
-  /// parallel region (Solver::update_points: one fork per step). The number of chunks of the
-  /// step;
+  /// The update of body.stress from body.L (and the law's state) over one step of length dt [s],
+  /// in independent chunks of points: the solver runs every chunk (in parallel, any order; see
+  /// Solver::update_points), then end_update once. The number of chunks of the step:
   virtual std::int64_t chunk_count(const Body<G>& body) const = 0;
   /// chunk c's update; returns the lowest index of a point of the chunk whose new stress is not
   /// finite, or kAllFinite. Chunks touch only their own points' state.
@@ -57,14 +53,8 @@ class StressLaw {
   /// Once after all chunks, with the lowest such index over the body (a law that stops the run
   /// on it throws here).
   virtual void end_update(Body<G>& body, double dt_s, std::int64_t first_bad) = 0;
-  /// Cost of one point's update relative to a simple law's (the solver runs the costly bodies'
-  /// chunks first).
-  virtual double relative_cost_per_point() const { return 1.0; }
-  /// Whether the chunks' costs vary (the threads then steal each other's remaining chunks at the
-  /// end of their static shares); otherwise each thread takes only its static share. A static
-  /// share holds the points the thread maps in G2P and scatters in P2G, so their data stay in that
-  /// core's caches.
-  virtual bool uneven_chunks() const { return false; }
+  /// How the solver should schedule the chunks (see ScheduleHint).
+  virtual ScheduleHint schedule_hint() const { return {}; }
   /// Fastest wave speed [m/s] at the current state (for the stable time step, model.md §6).
   virtual double max_wave_speed(const Body<G>& body) const = 0;
   /// Largest stable Δt [s] of the law's own diffusion on a grid of cell size h (viscous limit
@@ -72,7 +62,7 @@ class StressLaw {
   virtual double viscous_dt_limit(const Body<G>& /*body*/, double /*h_m*/) const { return INFINITY; }
   /// Short name for messages.
   virtual const char* name() const = 0;
-  /// The NaN guard fused into update_stress: the lowest index of a point whose new stress is not
+  /// The NaN guard fused into the chunks' update: the lowest index of a point whose new stress is not
   /// finite, kAllFinite, or kNotChecked (the default: the runner then scans the stresses itself).
   virtual std::int64_t first_non_finite_stress() const { return kNotChecked; }
 };

@@ -46,7 +46,7 @@ class GranularBodyLaw final : public StressLaw<G> {
 
   // Chunks of kChunk points: the cost per point ranges from a closed form to tens of Newton steps
   // and an implicit structure solve, and it is clustered in space (points are stored by region),
-  // so the threads steal each other's remaining chunks (uneven_chunks, Solver::update_points; a
+  // so the threads steal each other's remaining chunks (ScheduleHint::uneven_chunks; a
   // plain static split left one thread waiting: rod impact, 1.3x faster stress pass on 2 threads
   // with a dynamic schedule, which stealing keeps while a point stays with its thread). Each point is
   // independent: the results do not depend on the schedule. Within a chunk the law runs its
@@ -91,9 +91,9 @@ class GranularBodyLaw final : public StressLaw<G> {
                                      fmt::join(body.x_m[q].data(), body.x_m[q].data() + G::dim, ", "),
                                      law_.describe(u, before, D, W, dt_s, phi_of(body, q))));
   }
-  /// (a point takes ≈ 10× the fluid's update: the trial, the branch, Newton lanes)
-  double relative_cost_per_point() const override { return 10.0; }
-  bool uneven_chunks() const override { return true; }
+  /// A point takes ≈ 10× the fluid's update (the trial, the branch, Newton lanes), and the chunks'
+  /// costs vary (see kChunk).
+  ScheduleHint schedule_hint() const override { return {.relative_cost_per_point = 10.0, .uneven_chunks = true}; }
 
   /// Fastest granular wave: sqrt((K + 4G/3)/(phi rho_s)) at the loosest point (phi >= 0.05 so
   /// isolated surface points do not stall the run; they carry no stress when separated).
@@ -104,7 +104,7 @@ class GranularBodyLaw final : public StressLaw<G> {
     return body.size() > 0 ? std::sqrt((K_ + 4.0 * G_ / 3.0) / (phi_min * rho_s_)) : 0.0;
   }
   const char* name() const override { return "granular (E16-E24)"; }
-  /// A non-finite result never reaches the stresses: update_stress throws with the diagnosis.
+  /// A non-finite result never reaches the stresses: end_update throws with the diagnosis.
   std::int64_t first_non_finite_stress() const override { return kAllFinite; }
   const material::GranularLaw& law() const { return law_; }
 

@@ -13,11 +13,9 @@
 // `resolve_contacts()`.
 // Rigid bodies (prescribed or free translation) and motors: see contact.hpp and docs/contact.md.
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <memory>
-#include <omp.h>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -32,6 +30,7 @@
 #include "oobleck/mpm/boundary.hpp"
 #include "oobleck/mpm/contact.hpp"
 #include "oobleck/mpm/grid.hpp"
+#include "oobleck/mpm/parallel.hpp"
 #include "oobleck/mpm/shape.hpp"
 #include "oobleck/mpm/transfer.hpp"
 
@@ -65,6 +64,40 @@ struct SolverOptions {
   MixtureOptions<G> mixture;                            ///< used when a Fluid body exists
 };
 
+/// Phase 6 for one body, by the calling thread of a region: G2P's blocks of `task` in static
+/// shares with stealing (set `set` of `shares`, started with task.blocks). Returns the lowest
+/// index of a non-finite point among the blocks this thread ran, or kAllFinite.
+template <class G>
+std::int64_t run_g2p_share(const parallel::Team& team, parallel::StealingShares& shares, int set,
+                           const G2PTask<G>& task) {
+  constexpr std::int64_t kBlocksAtATime = 4;  // (4 × 32 points taken from a share at a time)
+  std::int64_t bad = kAllFinite;
+  shares.run(team, set, task.blocks, kBlocksAtATime,
+             [&](std::int64_t b0, std::int64_t b1) { bad = std::min(bad, task.run(b0, b1)); });
+  return bad;
+}
+
+/// Phase 7 for one body, by the calling thread of a region: the law's chunks as its ScheduleHint
+/// says (uneven: static shares with stealing, set `set` of `shares`, started with the chunk count;
+/// otherwise the thread's static share). Returns the lowest index of a non-finite point among the
+/// chunks this thread ran, or kAllFinite. end_update follows after the region.
+template <class G>
+std::int64_t run_law_share(const parallel::Team& team, parallel::StealingShares& shares, int set, StressLaw<G>& law,
+                           Body<G>& body, double dt_s) {
+  const std::int64_t chunks = law.chunk_count(body);
+  std::int64_t bad = kAllFinite;
+  auto run = [&](std::int64_t c0, std::int64_t c1) {
+    for (std::int64_t c = c0; c < c1; ++c) bad = std::min(bad, law.update_chunk(body, dt_s, c));
+  };
+  if (law.schedule_hint().uneven_chunks) {
+    shares.run(team, set, chunks, 1, run);
+  } else {
+    const parallel::Range r = team.share(chunks);
+    run(r.begin, r.end);
+  }
+  return bad;
+}
+
 /// Number of nodes per axis in the support of a kernel.
 inline int kernel_support(ShapeKind k) {
   switch (k) {
@@ -96,7 +129,7 @@ class Solver {
         !(opt_.gimp_half_width_cells > 0.0 && opt_.gimp_half_width_cells <= 0.5))
       throw InputError(fmt::format("mpm: uGIMP half width must be in (0, 0.5] cells, got {}",
                                    opt_.gimp_half_width_cells));
-    threads_ = opt_.threads > 0 ? opt_.threads : omp_get_max_threads();
+    threads_ = opt_.threads > 0 ? opt_.threads : parallel::max_threads();
   }
 
   /// Add a body. At most one Grains and one Fluid body (they are coupled at the nodes).
@@ -226,31 +259,23 @@ class Solver {
           opt_.dt_s, dt_max, cfl, grid_.h_m));
   }
 
-  /// One explicit step of length options().dt_s.
+  /// One explicit step of length options().dt_s, in the phases of docs/mpm.md ("The step").
   void step() {
     with_support([&](auto S) {
       constexpr int K = ipow(decltype(S)::value, D);
       StepClock clock(timings_);
-      apply_motors();                      // 3'. wheel motor (velocity level, §8) before P2G
-      particles_to_grid_all<K>();          // 1. N_ip, ∇N_ip cached per point, fused with
-                                           // 2. mass, momentum, internal force, and
-                                           // 3. gravity (in the pass over the nodes that sums
-                                           //    the threads' copies; motors later)
+      apply_motors();                // 1. motors: velocity-level drive of driven bodies (§8)
+      particles_to_grid_all<K>();    // 2. P2G: shape functions, mass, momentum, forces, gravity
       clock.lap(timings_.p2g);
       prepare_contact_arrays();
-      update_grid_and_couple(              // first, per body: 4a. walls: ghost contributions onto
-                                           // mirrors; rigid bodies' predictions; then per node,
-                                           // fused: 3a. porosity n_i, buoyancy split
-          [this] { scatter_contact_gradients<K>(); });  // E28, ∇p_0; 5. v = (mv + Δt f)/m with
-                                           // all non-drag forces; 3b. semi-implicit E29 drag;
-                                           // rigid bodies; beside it, contact's mass gradients
-      resolve_contacts();                  // 3c. body contact (§8), rigid-body velocities
+      update_grid_and_couple(        // 3. grid: walls fold ghosts, rigid predictions; porosity,
+          [this] { scatter_contact_gradients<K>(); });  // buoyancy (E28), v = (mv + Δt f)/m,
+                                     //    drag (E29); beside it, contact's mass gradients
+      resolve_contacts();            // 4. contact impulses (§8), rigid bodies' velocities
       clock.lap(timings_.grid);
-      update_points<K>(clock);             // 4b. walls on nodal velocities, ghost images (the
-                                           // bodies in parallel); q_i = (1−n_i) v^s_i + n_i v^f_i
-                                           // for E27;
-                                           // 6–7. x, v (FLIP/PIC or APIC), L, V ← V exp(Δt tr L);
-                                           // 8. laws (one parallel region; laps g2p and stress)
+      update_points<K>(clock);       // 5. walls on nodal velocities, mixture flux q (E27);
+                                     // 6. G2P: x, v (APIC or FLIP/PIC), C, L, V ← V exp(Δt tr L);
+                                     // 7. laws: stresses (and their state) from L
     });
     time_s_ += opt_.dt_s;
     ++steps_;
@@ -271,9 +296,9 @@ class Solver {
   static constexpr int ipow(int b, int e) { return e == 0 ? 1 : b * ipow(b, e - 1); }
 
   struct StepClock {
-    explicit StepClock(StepTimings&) : t0(omp_get_wtime()) {}
+    explicit StepClock(StepTimings&) : t0(parallel::wall_time()) {}
     void lap(double& acc) {
-      const double t = omp_get_wtime();
+      const double t = parallel::wall_time();
       acc += t - t0;
       t0 = t;
     }
@@ -289,15 +314,14 @@ class Solver {
     }
   }
 
-  /// Steps 1–3 for every body in one parallel region: each point's shape functions (into its
-  /// body's cache), its scatter, and gravity on the nodal masses (particles_to_grid, in its two
-  /// phases). Every thread scatters its static share of each body's points into its copy of that
-  /// body's nodal arrays with no barrier between the bodies; after one barrier, each thread sums
-  /// the copies over its share of the nodes, body after body. The same splits and sums as one
-  /// region per body: the same values.
+  /// Phase 2, P2G (model.md §6 steps 1–3) of every body in one region: each point's shape
+  /// functions (into its body's cache) and its scatter, then the nodal sums and gravity. Every
+  /// thread scatters its static share of each body's points into its copy of that body's nodal
+  /// arrays, with no barrier between the bodies; after one barrier, each thread sums the copies
+  /// over its share of the nodes, body after body.
   template <int K>
   void particles_to_grid_all() {
-    omp_set_num_threads(threads_);
+    parallel::set_threads(threads_);
     const bool apic = opt_.transfer == Transfer::Apic;
     const int nb = body_count();
     auto for_kernel = [&](auto&& f) {
@@ -309,21 +333,16 @@ class Solver {
     for (int b = 0; b < nb; ++b)
       for_kernel([&](auto kernel) { detail::p2g_prepare<G, K, decltype(kernel)>(*bodies_[b], caches_[b]); });
     p2g_outside_.assign(bodies_.size(), 0);
-#pragma omp parallel
-    {
-      for (int b = 0; b < nb; ++b) {
+    parallel::region([&](const parallel::Team& team) {
+      for (int b = 0; b < nb; ++b)
         for_kernel([&](auto kernel) {
-          const std::int64_t out = detail::p2g_scatter_share<G, K>(*bodies_[b], grid_, kernel, caches_[b], fields_[b],
-                                                                   apic, b == fluid_);
-          if (out > 0) {
-#pragma omp atomic
-            p2g_outside_[b] += out;
-          }
+          const std::int64_t out = detail::p2g_scatter_share<G, K>(team, *bodies_[b], grid_, kernel, caches_[b],
+                                                                   fields_[b], apic, b == fluid_);
+          if (out > 0) parallel::atomic_add(p2g_outside_[b], out);
         });
-      }
-#pragma omp barrier
-      for (int b = 0; b < nb; ++b) detail::p2g_sum_share(fields_[b], b == fluid_, &opt_.gravity_m_s2);
-    }
+      team.barrier();
+      for (int b = 0; b < nb; ++b) detail::p2g_sum_share(team, fields_[b], b == fluid_, &opt_.gravity_m_s2);
+    });
     for (int b = 0; b < nb; ++b)
       if (p2g_outside_[b] > 0)
         throw NumericalError(fmt::format(
@@ -334,15 +353,8 @@ class Solver {
 
   bool mixture() const { return grains_ >= 0 && fluid_ >= 0; }
 
-  /// Grid update of every body, with the phase coupling for the mixture. All three parts are
-  /// node-local, so they run in one pass over the nodes:
-  ///  * nodal porosity n_i = 1 − m^s_i/(ρ_s V_i) (clamped to [n_min, 1]; 1 where there are no
-  ///    grains or no granular body), the pressure force ∑ V p ∇N split grains (1 − n_i), fluid n_i
-  ///    (E28), and the same split of a background gradient −V_i ∇p_0 (the viscous τ_f already acts
-  ///    on the fluid alone);
-  ///  * predicted velocities v = (mv + Δt f)/m;
-  ///  * semi-implicit drag (model.md §5): C_i = V_i C_V(φ_i, Re_i) with the predicted velocities,
-  ///    F_d = C_i/(1 + Δt C_i (1/m_s + 1/m_f)) Δv; grains −F_d, fluid +F_d.
+  /// Phase 3, the grid pass: the grid update of every body, with the phase coupling for the
+  /// mixture. Its parts are node-local, so they run in one pass over the nodes (couple_nodes).
   ///
   /// Before the pass over the nodes, body by body (each touches only its own field, so the
   /// bodies run in parallel): the walls' ghost contributions folded onto their mirrors
@@ -365,77 +377,96 @@ class Solver {
     solids_.clear();
     for (int b = 0; b < nbodies; ++b)
       if (!rigid_[b].rigid() && b != grains_ && b != fluid_) solids_.push_back(&fields_[b]);
+    const int nn = grid_.node_count();
     if (fluid_ < 0) {
       for (int b = 0; b < nbodies; ++b) fold_and_predict(b);
       side();
-      for (GridField<G>* sf : solids_) update_grid_velocity(*sf, dt);
-      if (grains_ >= 0) update_grid_velocity(fields_[grains_], dt);
+      if (grains_ >= 0) solids_.push_back(&fields_[grains_]);
+      parallel::region(
+          [&](const parallel::Team& team) {
+            const parallel::Range r = team.share(nn);
+            for (GridField<G>* sf : solids_)
+              update_grid_velocity(*sf, dt, static_cast<int>(r.begin), static_cast<int>(r.end));
+          },
+          nn >= kParallelMinNodes);
       return;
     }
+    porosity_.resize(static_cast<std::size_t>(nn));
+    constexpr int kBlock = numerics::kMathBlock;
+    const int blocks = (nn + kBlock - 1) / kBlock;
+    parallel::region(
+        [&](const parallel::Team& team) {
+          team.dynamic(nbodies, 1, [&](std::int64_t b) { fold_and_predict(static_cast<int>(b)); });
+          team.barrier();
+          team.single_nowait(side);
+          team.dynamic(blocks, 4, [&](std::int64_t blk) {
+            const int i0 = static_cast<int>(blk) * kBlock;
+            couple_nodes(i0, std::min(kBlock, nn - i0));
+          });
+        },
+        nn >= kParallelMinNodes / 32);  // ~20 ns per node (drag)
+  }
+
+  /// The grid pass over the nodes [i0, i0 + count), count <= numerics::kMathBlock (a fluid body
+  /// exists):
+  ///  * nodal porosity n_i = 1 − m^s_i/(ρ_s V_i) (clamped to [n_min, 1]; 1 where there are no
+  ///    grains or no granular body), the pressure force ∑ V p ∇N split grains (1 − n_i), fluid n_i
+  ///    (E28), and the same split of a background gradient −V_i ∇p_0 (the viscous τ_f already acts
+  ///    on the fluid alone);
+  ///  * predicted velocities v = (mv + Δt f)/m (step 5), also of the deformable solids;
+  ///  * semi-implicit drag (model.md §5, E29): C_i = V_i C_V(φ_i, Re_i) with the predicted
+  ///    velocities, F_d = C_i/(1 + Δt C_i (1/m_s + 1/m_f)) Δv; grains −F_d, fluid +F_d. The drag
+  ///    coefficients of the block's mixture nodes are computed at once (their powers in vector
+  ///    lanes).
+  void couple_nodes(int i0, int count) {
+    constexpr int kBlock = numerics::kMathBlock;
+    const double dt = opt_.dt_s;
     GridField<G>& s = fields_[grains_ >= 0 ? grains_ : fluid_];
     GridField<G>& f = fields_[fluid_];
     const bool grains = grains_ >= 0;
     const auto& mx = opt_.mixture;
-    const int nn = f.nodes();
-    porosity_.resize(static_cast<std::size_t>(nn));
-    // Nodes in blocks: porosity, buoyancy split and predictions node by node, then the drag
-    // coefficients of the block's mixture nodes at once (their powers in vector lanes), then the
-    // semi-implicit drag.
-    constexpr int kBlock = numerics::kMathBlock;
-    const int blocks = (nn + kBlock - 1) / kBlock;
-#pragma omp parallel if (nn >= kParallelMinNodes / 32)  // ~20 ns per node (drag)
-    {
-#pragma omp for schedule(dynamic, 1)
-      for (int b = 0; b < nbodies; ++b) fold_and_predict(b);
-#pragma omp single nowait
-      side();
-#pragma omp for schedule(dynamic, 4) nowait
-    for (int blk = 0; blk < blocks; ++blk) {
-      const int i0 = blk * kBlock, nb = std::min(kBlock, nn - i0);
-      double phi_b[kBlock], Re_b[kBlock], C_V[kBlock];
-      bool drag[kBlock];
-      for (int j = 0; j < kBlock; ++j) {
-        phi_b[j] = 0.5;  // (a harmless stand-in for nodes without drag)
-        Re_b[j] = 0.0;
-        drag[j] = false;
-      }
-      for (GridField<G>* sf : solids_)
-        for (int j = 0; j < nb; ++j) predict_node(*sf, i0 + j, dt);
-      for (int j = 0; j < nb; ++j) {
-        const int i = i0 + j;
-        const double V = f.volume_m3[i], ms = grains ? s.mass_kg[i] : 0.0, mf = f.mass_kg[i];
-        double n = 1.0;
-        if (V > 0.0 && ms > 0.0) n = std::clamp(1.0 - ms / (mx.rho_s_kg_m3 * V), mx.min_porosity, 1.0);
-        porosity_[i] = n;
-        const Vec<NC> Fp = f.pressure_force_N[i] - V * mx.background_pressure_gradient_Pa_m;
-        f.force_N[i] += n * Fp;
-        predict_node(f, i, dt);
-        if (!grains) continue;
-        s.force_N[i] += (1.0 - n) * Fp;
-        predict_node(s, i, dt);
-        if (!(ms > 0.0 && mf > 0.0 && V > 0.0)) continue;
-        const Vec<NC> dv = s.velocity[i] - f.velocity[i];
-        const double rho_f = mf / (n * V);
-        drag[j] = true;
-        phi_b[j] = 1.0 - n;
-        Re_b[j] = material::drag_reynolds(dv.norm(), n, rho_f, mx.drag.d_m, mx.drag.eta_0_Pa_s);
-      }
-      bool any_drag = false;
-      for (int j = 0; j < nb; ++j) any_drag = any_drag || drag[j];
-      if (!any_drag) continue;
-      material::drag_coefficient_per_volume_block(mx.drag, phi_b, Re_b, C_V);
-      for (int j = 0; j < nb; ++j) {
-        if (!drag[j]) continue;
-        const int i = i0 + j;
-        const double ms = s.mass_kg[i], mf = f.mass_kg[i];
-        const double C = f.volume_m3[i] * C_V[j];
-        const Vec<NC> Fd = material::semi_implicit_drag_force(ms, mf, s.velocity[i], f.velocity[i], C, dt);
-        s.velocity[i] -= (dt / ms) * Fd;
-        f.velocity[i] += (dt / mf) * Fd;
-        s.force_N[i] -= Fd;  // kept for output/diagnostics
-        f.force_N[i] += Fd;
-      }
+    double phi_b[kBlock], Re_b[kBlock], C_V[kBlock];
+    bool drag[kBlock];
+    for (int j = 0; j < kBlock; ++j) {
+      phi_b[j] = 0.5;  // (a harmless stand-in for nodes without drag)
+      Re_b[j] = 0.0;
+      drag[j] = false;
     }
+    for (GridField<G>* sf : solids_)
+      for (int j = 0; j < count; ++j) predict_node(*sf, i0 + j, dt);
+    for (int j = 0; j < count; ++j) {
+      const int i = i0 + j;
+      const double V = f.volume_m3[i], ms = grains ? s.mass_kg[i] : 0.0, mf = f.mass_kg[i];
+      double n = 1.0;
+      if (V > 0.0 && ms > 0.0) n = std::clamp(1.0 - ms / (mx.rho_s_kg_m3 * V), mx.min_porosity, 1.0);
+      porosity_[i] = n;
+      const Vec<NC> Fp = f.pressure_force_N[i] - V * mx.background_pressure_gradient_Pa_m;
+      f.force_N[i] += n * Fp;
+      predict_node(f, i, dt);
+      if (!grains) continue;
+      s.force_N[i] += (1.0 - n) * Fp;
+      predict_node(s, i, dt);
+      if (!(ms > 0.0 && mf > 0.0 && V > 0.0)) continue;
+      const Vec<NC> dv = s.velocity[i] - f.velocity[i];
+      const double rho_f = mf / (n * V);
+      drag[j] = true;
+      phi_b[j] = 1.0 - n;
+      Re_b[j] = material::drag_reynolds(dv.norm(), n, rho_f, mx.drag.d_m, mx.drag.eta_0_Pa_s);
+    }
+    bool any_drag = false;
+    for (int j = 0; j < count; ++j) any_drag = any_drag || drag[j];
+    if (!any_drag) return;
+    material::drag_coefficient_per_volume_block(mx.drag, phi_b, Re_b, C_V);
+    for (int j = 0; j < count; ++j) {
+      if (!drag[j]) continue;
+      const int i = i0 + j;
+      const double ms = s.mass_kg[i], mf = f.mass_kg[i];
+      const double C = f.volume_m3[i] * C_V[j];
+      const Vec<NC> Fd = material::semi_implicit_drag_force(ms, mf, s.velocity[i], f.velocity[i], C, dt);
+      s.velocity[i] -= (dt / ms) * Fd;
+      f.velocity[i] += (dt / mf) * Fd;
+      s.force_N[i] -= Fd;  // kept for output/diagnostics
+      f.force_N[i] += Fd;
     }
   }
 
@@ -578,20 +609,41 @@ class Solver {
     return swirl;
   }
 
-  /// Step 4b (the walls' conditions, body by body), the mixture flux and steps 6–8 for every
-  /// body in one parallel region (one fork per step; barriers after the walls, after the flux
-  /// pass, and between G2P and the laws).
+  /// On one thread of update_points' region, after the swirl test: the G2P tasks of the deformable
+  /// bodies (their kernels chosen by the test) and the stealing shares of the G2P tasks and of the
+  /// law bodies.
+  template <int K>
+  void prepare_point_tasks(std::uint64_t swirl, int team) {
+    const int ntasks = static_cast<int>(g2p_bodies_.size());
+    g2p_tasks_.clear();
+    for (int k = 0; k < ntasks; ++k) {
+      const int b = g2p_bodies_[k];
+      g2p_tasks_.push_back(make_g2p_task<G, K>(
+          *bodies_[b], caches_[b], fields_[b], grid_, opt_.transfer, opt_.flip_fraction, opt_.dt_s,
+          b == fluid_ ? porosity_.data() : nullptr, b == fluid_ ? flux_.data() : nullptr,
+          G::has_hoop_terms && (swirl >> std::min(k, 63) & 1u) == 0));
+    }
+    shares_.resize(ntasks + static_cast<int>(law_bodies_.size()), team);
+    for (int k = 0; k < ntasks; ++k) shares_.start(k, g2p_tasks_[k].blocks);
+    for (std::size_t k = 0; k < law_bodies_.size(); ++k) {
+      Body<G>& body = *bodies_[law_bodies_[k]];
+      shares_.start(ntasks + static_cast<int>(k), body.law->chunk_count(body));
+    }
+  }
+
+  /// Phases 5–7 for every body in one parallel region (one fork per step; barriers after the
+  /// walls, after the flux pass, and between G2P and the laws).
   ///
-  /// G2P (6–7): the deformable bodies one after the other with no barrier between them, each
+  /// G2P (6): the deformable bodies one after the other with no barrier between them, each
   /// thread first its static share of the body's blocks — the split of P2G's scatter, the points
   /// whose data are in its core's caches — then what is left of the other threads' shares
   /// (stealing: a slower core's points move to the other only at the end of its share).
   /// Rigid bodies' points move with their body, before the region.
   ///
-  /// The laws (8): the bodies with costly, uneven chunks first (the granular law) in static shares
-  /// with stealing, then the others (the fluid's, an elastic body's) in static shares: the points
-  /// each thread maps in G2P and scatters in P2G (handing the fluid's chunks out dynamically made
-  /// the next P2G and G2P 5–14% slower on two threads). No barrier between the bodies.
+  /// The laws (7): the bodies with costly, uneven chunks first (ScheduleHint; the granular law)
+  /// in static shares with stealing, then the others (the fluid's, an elastic body's) in static
+  /// shares: the points each thread maps in G2P and scatters in P2G. No barrier between the
+  /// bodies; then each law's end_update, in body order.
   ///
   /// Every point's update is independent of the others: the results do not depend on the
   /// schedule (bit for bit the same on any number of threads as a serial run of the same code).
@@ -614,7 +666,8 @@ class Solver {
     for (int b = 0; b < nb; ++b)
       if (bodies_[b]->law) law_bodies_.push_back(b);
     std::stable_sort(law_bodies_.begin(), law_bodies_.end(), [&](int a, int b) {
-      return bodies_[a]->law->relative_cost_per_point() > bodies_[b]->law->relative_cost_per_point();
+      return bodies_[a]->law->schedule_hint().relative_cost_per_point >
+             bodies_[b]->law->schedule_hint().relative_cost_per_point;
     });
     law_first_bad_.assign(bodies_.size(), kAllFinite);
     const double dt = opt_.dt_s;
@@ -626,102 +679,37 @@ class Solver {
     // ones on the first thread, the others waiting.
     const bool node_pass_parallel = nn >= kParallelMinNodes / 64;
     std::uint64_t swirl = 0;
-#pragma omp parallel
-    {
-      const int team = omp_get_num_threads(), t = omp_get_thread_num();
-      auto share_begin = [team](std::int64_t n, int u) {  // the split of schedule(static)
-        const std::int64_t q = n / team, r = n % team;
-        return u * q + std::min<std::int64_t>(u, r);
-      };
-      // Step 4b, the walls' conditions on every body's nodal velocities (each body its own field:
-      // the bodies in parallel; the barrier: the flux reads the constrained velocities).
-#pragma omp for schedule(dynamic, 1)
-      for (int b = 0; b < nb; ++b) apply_boundary_conditions<G>(grid_, bc_, fields_[b], opt_.dt_s);
-      {
-        std::uint64_t mine = 0;
-        if (node_pass_parallel)
-          mine = mixture_flux_and_swirl(static_cast<int>(share_begin(nn, t)), static_cast<int>(share_begin(nn, t + 1)));
-        else if (t == 0)
-          mine = mixture_flux_and_swirl(0, nn);
-        if (mine != 0) {
-#pragma omp atomic
-          swirl |= mine;
-        }
+    parallel::region([&](const parallel::Team& team) {
+      // Phase 5a: the walls' conditions on every body's nodal velocities (each body its own
+      // field: the bodies in parallel; the barrier: the flux reads the constrained velocities).
+      team.dynamic(nb, 1, [&](std::int64_t b) { apply_boundary_conditions<G>(grid_, bc_, fields_[b], opt_.dt_s); });
+      team.barrier();
+      // Phase 5b: the mixture flux and the swirl test, node by node.
+      std::uint64_t mine = 0;
+      if (node_pass_parallel) {
+        const parallel::Range r = team.share(nn);
+        mine = mixture_flux_and_swirl(static_cast<int>(r.begin), static_cast<int>(r.end));
+      } else if (team.rank() == 0) {
+        mine = mixture_flux_and_swirl(0, nn);
       }
-#pragma omp barrier
-      // The G2P tasks (their kernels chosen by the swirl test) and the counters of the shares: per
-      // G2P task, then per law body (those with uneven chunks), one per thread's share, each on
-      // its own cache line.
-#pragma omp single
-      {
-        g2p_tasks_.clear();
-        for (int k = 0; k < ntasks; ++k) {
-          const int b = g2p_bodies_[k];
-          g2p_tasks_.push_back(make_g2p_task<G, K>(
-              *bodies_[b], caches_[b], fields_[b], grid_, opt_.transfer, opt_.flip_fraction, opt_.dt_s,
-              b == fluid_ ? porosity_.data() : nullptr, b == fluid_ ? flux_.data() : nullptr,
-              G::has_hoop_terms && (swirl >> std::min(k, 63) & 1u) == 0));
-        }
-        const std::size_t need = static_cast<std::size_t>(ntasks + static_cast<int>(law_bodies_.size())) * team;
-        if (share_next_.size() < need) share_next_ = std::vector<ShareCounter>(need);
-        for (int k = 0; k < ntasks; ++k)
-          for (int u = 0; u < team; ++u)
-            share_next_[k * team + u].next.store(share_begin(g2p_tasks_[k].blocks, u), std::memory_order_relaxed);
-        for (std::size_t k = 0; k < law_bodies_.size(); ++k) {
-          Body<G>& body = *bodies_[law_bodies_[k]];
-          const std::int64_t chunks = body.law->chunk_count(body);
-          for (int u = 0; u < team; ++u)
-            share_next_[(ntasks + k) * team + u].next.store(share_begin(chunks, u), std::memory_order_relaxed);
-        }
-      }  // (the barrier: the tasks and every counter are set)
-      // Static shares with stealing over n units in steps of `grain`: each thread runs its own
-      // share from the front, then the remaining units of the others' shares. Every unit is taken
-      // once (one counter per share).
-      auto run_shares = [&](int set, std::int64_t n, std::int64_t grain, auto&& body_of_units) {
-        for (int k = 0; k < team; ++k) {
-          const int u = (t + k) % team;
-          const std::int64_t end = share_begin(n, u + 1);
-          std::atomic<std::int64_t>& next = share_next_[set * team + u].next;
-          for (;;) {
-            const std::int64_t c = next.fetch_add(grain, std::memory_order_relaxed);
-            if (c >= end) break;
-            body_of_units(c, std::min(c + grain, end));
-          }
-        }
-      };
+      if (mine != 0) parallel::atomic_or(swirl, mine);
+      team.barrier();
+      team.single([&] { prepare_point_tasks<K>(swirl, team.size()); });
+      // Phase 6, G2P: each body's blocks in static shares with stealing.
       for (int k = 0; k < ntasks; ++k) {
-        const G2PTask<G>& task = g2p_tasks_[k];
-        std::int64_t bad = kAllFinite;
-        run_shares(k, task.blocks, kG2PStealBlocks,
-                   [&](std::int64_t b0, std::int64_t b1) { bad = std::min(bad, task.run(b0, b1)); });
-        if (bad != kAllFinite) {
-#pragma omp critical(oobleck_g2p_first_bad)
-          non_finite_kinematics_[g2p_bodies_[k]] = std::min(non_finite_kinematics_[g2p_bodies_[k]], bad);
-        }
+        const std::int64_t bad = run_g2p_share(team, shares_, k, g2p_tasks_[k]);
+        if (bad != kAllFinite) parallel::atomic_min(non_finite_kinematics_[g2p_bodies_[k]], bad);
       }
-#pragma omp barrier
-#pragma omp master
-      clock.lap(timings_.g2p);
+      team.barrier();
+      if (team.rank() == 0) clock.lap(timings_.g2p);
+      // Phase 7, the laws, costliest bodies first.
       for (std::size_t k = 0; k < law_bodies_.size(); ++k) {
         const int b = law_bodies_[k];
-        Body<G>& body = *bodies_[b];
-        StressLaw<G>& law = *body.law;
-        const std::int64_t chunks = law.chunk_count(body);
-        std::int64_t bad = kAllFinite;
-        if (law.uneven_chunks()) {
-          run_shares(ntasks + static_cast<int>(k), chunks, 1, [&](std::int64_t c0, std::int64_t) {
-            bad = std::min(bad, law.update_chunk(body, dt, c0));
-          });
-        } else {
-#pragma omp for schedule(static) nowait
-          for (std::int64_t c = 0; c < chunks; ++c) bad = std::min(bad, law.update_chunk(body, dt, c));
-        }
-        if (bad != kAllFinite) {
-#pragma omp critical(oobleck_law_first_bad)
-          law_first_bad_[b] = std::min(law_first_bad_[b], bad);
-        }
+        const std::int64_t bad =
+            run_law_share(team, shares_, ntasks + static_cast<int>(k), *bodies_[b]->law, *bodies_[b], dt);
+        if (bad != kAllFinite) parallel::atomic_min(law_first_bad_[b], bad);
       }
-    }
+    });
     for (int b = 0; b < nb; ++b)  // (in body order, as the laws were run before)
       if (bodies_[b]->law) bodies_[b]->law->end_update(*bodies_[b], dt, law_first_bad_[b]);
     clock.lap(timings_.stress);
@@ -756,12 +744,7 @@ class Solver {
   std::vector<std::int64_t> p2g_outside_;  ///< per body: points whose support left the grid (P2G)
   std::vector<int> law_bodies_;
   std::vector<std::int64_t> law_first_bad_;
-  struct alignas(64) ShareCounter {  ///< next unit of one thread's share (own cache line)
-    std::atomic<std::int64_t> next{0};
-  };
-  std::vector<ShareCounter> share_next_;
-  /// G2P blocks taken at a time from a share (4 × 32 points).
-  static constexpr std::int64_t kG2PStealBlocks = 4;
+  parallel::StealingShares shares_;  ///< the G2P tasks' and the law bodies' shares
   double time_s_ = 0.0;
   std::int64_t steps_ = 0;
 };

@@ -1,12 +1,12 @@
 #pragma once
 // Grid fields and the particle↔grid kernels of one body (model.md §6 steps 2, 5, 6, 7).
-// Free functions over the body's arrays, the shape cache and the body's grid field.
+// Free functions over the body's arrays, the shape cache and the body's grid field, each over a
+// range of points or nodes; which thread runs which range is decided in parallel.hpp.
 //
-// Race-free, deterministic scatter: each OpenMP thread accumulates P2G into its own copy of the
-// nodal arrays (thread 0 into the field itself) over a static partition of the points; the copies
-// are then summed node by node in thread order. For a fixed thread count the result is bitwise
+// Race-free, deterministic scatter: each thread accumulates P2G into its own copy of the nodal
+// arrays (thread 0 into the field itself) over its static share of the points; the copies are
+// then summed node by node in thread order. For a fixed thread count the result is bitwise
 // reproducible.
-#include <omp.h>
 
 #include <algorithm>
 #include <bit>
@@ -17,6 +17,7 @@
 
 #include "oobleck/mpm/body.hpp"
 #include "oobleck/mpm/grid.hpp"
+#include "oobleck/mpm/parallel.hpp"
 #include "oobleck/mpm/shape.hpp"
 #include "oobleck/numerics/vector_math.hpp"
 
@@ -93,7 +94,7 @@ struct SecondAxisFactors {
   }
 };
 
-/// Scatter of point p (see particles_to_grid), with the APIC and
+/// Scatter of point p (P2G, see p2g_scatter_range), with the APIC and
 /// split-pressure branches resolved at compile time and scalar per-point temporaries (no
 /// stack round trips of Eigen 3-vectors in the node loop). Arithmetic order per component is that
 /// of the Eigen expressions it replaces.
@@ -102,7 +103,7 @@ struct SecondAxisFactors {
 /// are zero, so all its θ terms on the nodes are zeros (of either sign) and adding them to the
 /// nodal sums (which start at +0) changes no bit: they are left out.
 ///
-/// Always inlined: particles_to_grid calls it through particles_to_grid_point (axisymmetric) or
+/// Always inlined: p2g_scatter_range calls it through particles_to_grid_point (axisymmetric) or
 /// inlines it into its loop over the points (plane strain, 3D; callgrind, wheel set-up: 1.4% fewer
 /// instructions per step; for the axisymmetric kernels GCC's own choice, a call, is the shorter).
 template <class G, int K, bool Apic, bool Split, bool NoSwirl = false>
@@ -274,14 +275,6 @@ inline bool point_without_swirl(const Body<G>& body, std::int64_t p) {
 
 }  // namespace detail
 
-/// Body loads (model.md §6 step 3): gravity f_i += m_i g.
-template <class G>
-void add_gravity(GridField<G>& field, const Vec<G::ncomp>& g_m_s2) {
-  const int nn = field.nodes();
-#pragma omp parallel for schedule(static) if (nn >= kParallelMinNodes)
-  for (int i = 0; i < nn; ++i) field.force_N[i] += field.mass_kg[i] * g_m_s2;
-}
-
 namespace detail {
 
 /// P2G, before its parallel region: the shape cache sized for the body's points.
@@ -293,52 +286,53 @@ void p2g_prepare(const Body<G>& body, ShapeCache<G::dim>& cache) {
   cache.apic_by_gradient = Kernel::apic_by_gradient;
 }
 
-/// P2G's first phase, called by every thread of an enclosing parallel region (its `omp for` binds
-/// to that region; no barrier at its end): the calling thread zeroes its copy of the nodal arrays
-/// (thread 0: the field's own arrays) and scatters its static share of the points into it.
-/// Returns the number of its points whose support left the stored nodes.
-template <class G, int K, class Kernel>
-std::int64_t p2g_scatter_share(const Body<G>& body, const Grid<G::dim>& grid, const Kernel& kernel,
-                               ShapeCache<G::dim>& cache, GridField<G>& field, bool apic, bool split_pressure) {
-  constexpr int NC = G::ncomp, S = support_of<G::dim>(K);
-  const std::int64_t np = body.size();
-  const int nn = field.nodes();
-  const StencilGrid<G::dim> sg(grid);
-  std::int64_t bad = 0;
-  const int t = omp_get_thread_num();
-  double* m = t == 0 ? field.mass_kg.data() : field.t_mass[t - 1].data();
-  Vec<NC>* mv = t == 0 ? field.momentum.data() : field.t_momentum[t - 1].data();
-  Vec<NC>* f = t == 0 ? field.force_N.data() : field.t_force[t - 1].data();
-  Vec<NC>* fp = t == 0 ? field.pressure_force_N.data() : field.t_pressure[t - 1].data();
-  double* vol = t == 0 ? field.volume_m3.data() : field.t_volume[t - 1].data();
-  for (int i = 0; i < nn; ++i) {
-    m[i] = 0.0;
-    mv[i].setZero();
-    f[i].setZero();
-  }
-  if (split_pressure) {
-    for (int i = 0; i < nn; ++i) {
-      fp[i].setZero();
-      vol[i] = 0.0;
+/// The calling thread's copy of a field's nodal sums (thread 0: the field's own arrays).
+template <class G>
+struct ScatterArrays {
+  double *m, *mv, *f, *fp, *vol;  ///< mass, momentum, force, pressure force (NC per node), volume
+
+  ScatterArrays(GridField<G>& field, int t)
+      : m(t == 0 ? field.mass_kg.data() : field.t_mass[t - 1].data()),
+        mv((t == 0 ? field.momentum.data() : field.t_momentum[t - 1].data())->data()),
+        f((t == 0 ? field.force_N.data() : field.t_force[t - 1].data())->data()),
+        fp((t == 0 ? field.pressure_force_N.data() : field.t_pressure[t - 1].data())->data()),
+        vol(t == 0 ? field.volume_m3.data() : field.t_volume[t - 1].data()) {}
+  /// Zero the sums of nn nodes (the pressure force and volume only when the scatter splits them).
+  void zero(int nn, bool split_pressure) const {
+    constexpr int NC = G::ncomp;
+    std::fill(m, m + nn, 0.0);
+    std::fill(mv, mv + static_cast<std::int64_t>(nn) * NC, 0.0);
+    std::fill(f, f + static_cast<std::int64_t>(nn) * NC, 0.0);
+    if (split_pressure) {
+      std::fill(fp, fp + static_cast<std::int64_t>(nn) * NC, 0.0);
+      std::fill(vol, vol + nn, 0.0);
     }
   }
-  double* mvd = mv->data();
-  double* fd = f->data();
-  double* fpd = fp->data();
+};
+
+/// P2G's scatter (steps 1–2) of the points [p0, p1) into one copy of the nodal sums: each point's
+/// shape functions (into `cache`, for the rest of the step) and its contributions. Returns the
+/// number of these points whose support left the stored nodes.
+template <class G, int K, class Kernel>
+std::int64_t p2g_scatter_range(const Body<G>& body, const Grid<G::dim>& grid, const Kernel& kernel,
+                               ShapeCache<G::dim>& cache, const ScatterArrays<G>& out, bool apic, bool split_pressure,
+                               std::int64_t p0, std::int64_t p1) {
+  constexpr int S = support_of<G::dim>(K);
+  const StencilGrid<G::dim> sg(grid);
+  std::int64_t bad = 0;
   auto scatter = [&]<bool A, bool Sp>() {
-#pragma omp for schedule(static) nowait
-    for (std::int64_t p = 0; p < np; ++p) {
+    for (std::int64_t p = p0; p < p1; ++p) {
       if (!make_stencil(grid, sg, kernel, body.x_m[p], cache.template stencil<S>(p), cache.inv_D[p])) ++bad;
       if constexpr (G::has_hoop_terms) {
         // Beds without swirl (the intruder, the rod) skip the θ terms: the same sums; points
         // with swirl take the general kernel.
         if (point_without_swirl(body, p))
-          particles_to_grid_point<G, K, A, Sp, true>(body, cache, p, m, mvd, fd, fpd, vol);
+          particles_to_grid_point<G, K, A, Sp, true>(body, cache, p, out.m, out.mv, out.f, out.fp, out.vol);
         else
-          particles_to_grid_point<G, K, A, Sp>(body, cache, p, m, mvd, fd, fpd, vol);
+          particles_to_grid_point<G, K, A, Sp>(body, cache, p, out.m, out.mv, out.f, out.fp, out.vol);
       } else {
         // (plane strain and 3D: inlined here)
-        particles_to_grid_point_inlined<G, K, A, Sp>(body, cache, p, m, mvd, fd, fpd, vol);
+        particles_to_grid_point_inlined<G, K, A, Sp>(body, cache, p, out.m, out.mv, out.f, out.fp, out.vol);
       }
     }
   };
@@ -352,19 +346,30 @@ std::int64_t p2g_scatter_share(const Body<G>& body, const Grid<G::dim>& grid, co
   return bad;
 }
 
-/// P2G's second phase, after a barrier that follows every thread's p2g_scatter_share (called by
-/// every thread of the region; no barrier at its end): the copies' sums in thread order over the
-/// calling thread's static share of the nodes, and the body load of step 3 (gravity) on the summed
-/// mass. Each node is summed by one thread, in the same order whichever it is.
+/// P2G's first phase for the calling thread of a region: it zeroes its copy of the nodal sums and
+/// scatters its static share of the points into it (no barrier). Returns the number of its points
+/// whose support left the stored nodes.
+template <class G, int K, class Kernel>
+std::int64_t p2g_scatter_share(const parallel::Team& team, const Body<G>& body, const Grid<G::dim>& grid,
+                               const Kernel& kernel, ShapeCache<G::dim>& cache, GridField<G>& field, bool apic,
+                               bool split_pressure) {
+  const ScatterArrays<G> out(field, team.rank());
+  out.zero(field.nodes(), split_pressure);
+  const parallel::Range r = team.share(body.size());
+  return p2g_scatter_range<G, K>(body, grid, kernel, cache, out, apic, split_pressure, r.begin, r.end);
+}
+
+/// P2G's second phase (step 3's gravity with it) over the nodes [i0, i1): the threads' copies
+/// summed into the field in thread order, then f_i += m_i g. Each node is summed by one thread, in
+/// the same order whichever it is.
 template <class G>
-void p2g_sum_share(GridField<G>& field, bool split_pressure, const Vec<G::ncomp>* gravity_m_s2) {
+void p2g_sum_nodes(GridField<G>& field, int copies, bool split_pressure, const Vec<G::ncomp>* gravity_m_s2, int i0,
+                   int i1) {
   constexpr int NC = G::ncomp;
-  const int nn = field.nodes(), team = omp_get_num_threads();
   const bool gravity = gravity_m_s2 != nullptr && gravity_m_s2->squaredNorm() != 0.0;
   const Vec<NC> g = gravity ? *gravity_m_s2 : Vec<NC>::Zero();
-#pragma omp for schedule(static) nowait
-  for (int i = 0; i < nn; ++i) {
-    for (int u = 1; u < team; ++u) {
+  for (int i = i0; i < i1; ++i) {
+    for (int u = 1; u < copies; ++u) {
       field.mass_kg[i] += field.t_mass[u - 1][i];
       field.momentum[i] += field.t_momentum[u - 1][i];
       field.force_N[i] += field.t_force[u - 1][i];
@@ -377,42 +382,22 @@ void p2g_sum_share(GridField<G>& field, bool split_pressure, const Vec<G::ncomp>
   }
 }
 
-}  // namespace detail
-
-/// P2G (model.md §6 step 2): nodal mass, momentum (with the APIC affine term when `apic`),
-/// internal force f_i = −∑_p V_p σ_p ∇N_ip, and external point loads ∑_p N_ip f_ext,p. K = local nodes per point (support^dim).
-/// With `split_pressure` (the fluid phase) the stress is split as σ = τ − p 1 (p = −tr σ/3): the
-/// internal force gets only τ, the pressure part ∑ V_p p_p ∇N_ip goes to `pressure_force_N` for the
-/// buoyancy split (E28), and the nodal mixture volume ∑ N_ip V_p is accumulated. With
-/// `gravity_m_s2`, the body load of step 3 follows, f_i += m_i g (in the pass that sums the
-/// threads' copies: the same values as add_gravity afterwards).
-///
-/// The shape functions of the step (model.md §6 step 1) are computed here, point by point, with
-/// the same make_stencil as compute_shape_cache, and stored in `cache` for the rest of the step
-/// (contact, G2P): fused with the scatter, their latency overlaps its memory traffic. Returns the
-/// number of points whose support leaves the stored nodes (their scatter went to clamped nodes;
-/// the caller stops the run).
-template <class G, int K, class Kernel>
-std::int64_t particles_to_grid(const Body<G>& body, const Grid<G::dim>& grid, const Kernel& kernel,
-                               ShapeCache<G::dim>& cache, GridField<G>& field, bool apic, bool split_pressure = false,
-                               const Vec<G::ncomp>* gravity_m_s2 = nullptr) {
-  detail::p2g_prepare<G, K, Kernel>(body, cache);
-  std::int64_t bad = 0;
-#pragma omp parallel num_threads(field.max_threads()) reduction(+ : bad)
-  {
-    bad += detail::p2g_scatter_share<G, K>(body, grid, kernel, cache, field, apic, split_pressure);
-#pragma omp barrier
-    detail::p2g_sum_share(field, split_pressure, gravity_m_s2);
-  }
-  return bad;
+/// P2G's second phase for the calling thread of a region, after a barrier that follows every
+/// thread's p2g_scatter_share: the sums over its static share of the nodes (no barrier).
+template <class G>
+void p2g_sum_share(const parallel::Team& team, GridField<G>& field, bool split_pressure,
+                   const Vec<G::ncomp>* gravity_m_s2) {
+  const parallel::Range r = team.share(field.nodes());
+  p2g_sum_nodes(field, team.size(), split_pressure, gravity_m_s2, static_cast<int>(r.begin), static_cast<int>(r.end));
 }
 
-/// Grid update (model.md §6 step 5): v_old = mv/m, v = (mv + Δt f)/m on nodes with mass.
+}  // namespace detail
+
+/// Grid update (model.md §6 step 5) of the nodes [i0, i1): v_old = mv/m, v = (mv + Δt f)/m on
+/// nodes with mass, zero elsewhere.
 template <class G>
-void update_grid_velocity(GridField<G>& field, double dt_s) {
-  const int nn = field.nodes();
-#pragma omp parallel for schedule(static) if (nn >= kParallelMinNodes)
-  for (int i = 0; i < nn; ++i) {
+void update_grid_velocity(GridField<G>& field, double dt_s, int i0, int i1) {
+  for (int i = i0; i < i1; ++i) {
     const double m = field.mass_kg[i];
     if (m > 0.0) {
       field.velocity_old[i] = field.momentum[i] / m;
@@ -424,7 +409,7 @@ void update_grid_velocity(GridField<G>& field, double dt_s) {
   }
 }
 
-/// What G2P of one body reads and writes (see grid_to_particles).
+/// What G2P of one body reads and writes (see make_g2p_task).
 template <class G>
 struct G2PArgs {
   Body<G>* body = nullptr;
@@ -798,20 +783,6 @@ G2PTask<G> make_g2p_task(Body<G>& body, const ShapeCache<G::dim>& cache, const G
   else
     pick.template operator()<true, false>();
   return task;
-}
-
-/// G2P of the whole body, its blocks in a static split over the threads (the split of P2G's
-/// scatter, so a point's data stay in one core's caches).
-template <class G, int K>
-std::int64_t grid_to_particles(Body<G>& body, const ShapeCache<G::dim>& cache, const GridField<G>& field,
-                               const Grid<G::dim>& grid, Transfer transfer, double flip_fraction, double dt_s,
-                               const double* porosity = nullptr, const Vec<G::ncomp>* mixture_flux = nullptr) {
-  const G2PTask<G> task =
-      make_g2p_task<G, K>(body, cache, field, grid, transfer, flip_fraction, dt_s, porosity, mixture_flux);
-  std::int64_t bad = kAllFinite;
-#pragma omp parallel for schedule(static) reduction(min : bad)
-  for (std::int64_t blk = 0; blk < task.blocks; ++blk) bad = std::min(bad, task.run(blk, blk + 1));
-  return bad;
 }
 
 // The axisymmetric G2P is compiled in its own translation unit, transfer_axisymmetric.cpp, with
