@@ -1,8 +1,7 @@
 #pragma once
 // Scene [[body]] entries (scene/config.hpp BodyConfig) turned into solver bodies (model.md §8):
 // point lattices for boxes, discs and spoked wheels, the rigid/elastic motion, the contact pair
-// and the motor; plus the nodal averages of point fields that the scene analyses and snapshots
-// read (runner.cpp).
+// and the motor (used by scene/build.cpp; prescribed_velocity also by the run loop's ramp).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -12,13 +11,12 @@
 
 #include <fmt/format.h>
 
-#include "oobleck/analysis/data.hpp"
 #include "oobleck/core/error.hpp"
 #include "oobleck/mpm/laws.hpp"
 #include "oobleck/mpm/solver.hpp"
 #include "oobleck/scene/config.hpp"
 
-namespace oobleck::run {
+namespace oobleck::scene {
 
 /// Whether x lies inside the body's shape (box, disc, or hub + paddles of a spoked wheel).
 /// For periodic axes the caller passes x relative to the centre's image (minimum image).
@@ -134,61 +132,4 @@ std::pair<int, int> add_third_body(mpm::Solver<G>& solver, const scene::BodyConf
   return {index, pair};
 }
 
-/// Centre of mass of a body, periodic axes unwrapped about its first point (then wrapped).
-template <class G>
-mpm::Vec<G::dim> centre_of_mass(const mpm::Body<G>& body, const mpm::Grid<G::dim>& grid) {
-  constexpr int D = G::dim;
-  if (body.size() == 0) return mpm::Vec<D>::Zero();
-  const mpm::Vec<D> x0 = body.x_m[0];
-  mpm::Vec<D> s = mpm::Vec<D>::Zero();
-  double M = 0.0;
-  for (std::int64_t p = 0; p < body.size(); ++p) {
-    s += body.mass_kg[p] * mpm::periodic_difference<D>(grid, body.x_m[p], x0);
-    M += body.mass_kg[p];
-  }
-  mpm::Vec<D> c = x0 + s / M;
-  grid.wrap(c);
-  return c;
-}
-
-/// Mass-weighted nodal average of a point quantity over one or more bodies on the physical
-/// nodes of a 2D grid, with bilinear (tent) weights: value_i = Σ w_ip m_p q_p / Σ w_ip m_p
-/// (0 where no point contributes). Independent of the solver's kernel: a plain post-processing
-/// interpolation. `value(b, p)` gives q of point p of body b.
-template <class G, class F>
-analysis::GridField2D nodal_average(const mpm::Grid<2>& grid, const std::vector<const mpm::Body<G>*>& bodies,
-                                    F&& value) {
-  analysis::GridField2D out;
-  out.origin_x = grid.origin_m[0];
-  out.origin_y = grid.origin_m[1];
-  out.h = grid.h_m;
-  out.nx = static_cast<std::size_t>(grid.periodic[0] ? grid.cells[0] : grid.cells[0] + 1);
-  out.ny = static_cast<std::size_t>(grid.periodic[1] ? grid.cells[1] : grid.cells[1] + 1);
-  out.values.assign(out.nx * out.ny, 0.0);
-  std::vector<double> mass(out.values.size(), 0.0);
-  for (std::size_t b = 0; b < bodies.size(); ++b) {
-    const auto& body = *bodies[b];
-    for (std::int64_t p = 0; p < body.size(); ++p) {
-      const double q = value(b, p), m = body.mass_kg[p];
-      const double fx = (body.x_m[p][0] - out.origin_x) / out.h, fy = (body.x_m[p][1] - out.origin_y) / out.h;
-      const auto i0 = static_cast<long>(std::floor(fx)), j0 = static_cast<long>(std::floor(fy));
-      const double tx = fx - static_cast<double>(i0), ty = fy - static_cast<double>(j0);
-      for (int dj = 0; dj < 2; ++dj) {
-        for (int di = 0; di < 2; ++di) {
-          long i = i0 + di, j = j0 + dj;
-          if (grid.periodic[0]) i = ((i % static_cast<long>(out.nx)) + static_cast<long>(out.nx)) % static_cast<long>(out.nx);
-          if (grid.periodic[1]) j = ((j % static_cast<long>(out.ny)) + static_cast<long>(out.ny)) % static_cast<long>(out.ny);
-          if (i < 0 || j < 0 || i >= static_cast<long>(out.nx) || j >= static_cast<long>(out.ny)) continue;
-          const double w = (di ? tx : 1.0 - tx) * (dj ? ty : 1.0 - ty) * m;
-          const auto k = static_cast<std::size_t>(j) * out.nx + static_cast<std::size_t>(i);
-          out.values[k] += w * q;
-          mass[k] += w;
-        }
-      }
-    }
-  }
-  for (std::size_t k = 0; k < mass.size(); ++k) out.values[k] = mass[k] > 0.0 ? out.values[k] / mass[k] : 0.0;
-  return out;
-}
-
-}  // namespace oobleck::run
+}  // namespace oobleck::scene

@@ -1,0 +1,141 @@
+// [analysis] kind = "intrusion" (S3, scenes.md; docs/analysis.md "Fronts"): the intruder's
+// track and, at every sample, the nodal fields of the mixture's u_z and the grains' structure f
+// (E24); in the summary the fronts of u_z = fraction v_0 and of f = f_threshold below
+// (longitudinal) and beside (transverse) the intruder with their fitted speeds,
+// k_l = v_fl/v_0 - 1 and k_t = v_ft/v_0.
+#include <cmath>
+
+#include "oobleck/analysis/fronts.hpp"
+#include "oobleck/analysis/summary_json.hpp"
+#include "oobleck/core/error.hpp"
+#include "oobleck/run/analysis_kinds.hpp"
+#include "oobleck/run/body_track.hpp"
+#include "oobleck/run/field_frames.hpp"
+
+namespace oobleck::run {
+
+namespace {
+
+template <class G>
+class IntrusionAnalysis final : public SceneAnalysis<G> {
+  static constexpr int D = G::dim;
+  using Base = SceneAnalysis<G>;
+  using Base::cfg_;
+  using Base::scene_;
+
+ public:
+  IntrusionAnalysis(const scene::SceneConfig& config, const scene::BuiltScene<G>& scene)
+      : Base(config, scene), track_(scene) {}
+
+  void sample() override {
+    track_.sample();
+    if constexpr (D == 2) sample_fields();
+  }
+
+  void restore(const io::Checkpoint& cp) override {
+    if constexpr (D == 2) {
+      const auto shape = node_field_shape(this->solver().grid());
+      restore_intrusion_frames(cp, "analysis/uz", shape, uz_frames_);
+      restore_intrusion_frames(cp, "analysis/f", shape, f_frames_);
+    }
+    track_.restore(cp);
+  }
+
+  nlohmann::json result() const override;
+
+ protected:
+  void save_state(io::CheckpointWriter& cp) const override {
+    save_intrusion_frames(cp, "analysis/uz", uz_frames_);
+    save_intrusion_frames(cp, "analysis/f", f_frames_);
+    track_.save(cp);
+  }
+
+ private:
+  /// u_z of the mixture (grains and fluid) and f of the grains on the nodes, with the tip.
+  void sample_fields() {
+    auto& solver = this->solver();
+    std::vector<const mpm::Body<G>*> mix;
+    for (int b : {scene_.grains, scene_.fluid})
+      if (b >= 0) mix.push_back(&solver.body(b));
+    const double tip = body_tip(cfg_, scene_);
+    analysis::IntrusionFrame uz;
+    uz.time_s = solver.time_s();
+    uz.tip_z_m = tip;
+    uz.field = nodal_average<G>(solver.grid(), mix, [&](std::size_t b, std::int64_t p) { return mix[b]->v_m_s[p][1]; });
+    uz_frames_.push_back(std::move(uz));
+    if (scene_.grains >= 0 && scene_.granular_law) {
+      const auto* law = scene_.granular_law;
+      analysis::IntrusionFrame ff;
+      ff.time_s = solver.time_s();
+      ff.tip_z_m = tip;
+      ff.field = nodal_average<G>(solver.grid(), {&solver.body(scene_.grains)},
+                                  [&](std::size_t, std::int64_t p) { return law->f[static_cast<std::size_t>(p)]; });
+      f_frames_.push_back(std::move(ff));
+    }
+  }
+
+  BodyTrack<G> track_;
+  std::vector<analysis::IntrusionFrame> uz_frames_, f_frames_;
+};
+
+template <class G>
+nlohmann::json IntrusionAnalysis<G>::result() const {
+  nlohmann::json out = nlohmann::json::object();
+  const auto& track = track_.samples();
+  if (track.size() < 2 || uz_frames_.empty()) return out;
+  const scene::ThirdBody& tb = scene_.analysed_body();
+  const double h = cfg_.grid.cell_size_m;
+  const double sample_dt = track[1].t - track[0].t;
+  const double v0 = tb.cfg->velocity_m_s[1];
+  analysis::FrontGeometry geo;
+  geo.direction = v0 < 0 ? -1.0 : 1.0;
+  geo.intruder_radius_m = tb.cfg->max_m[0];
+  geo.axis_r_m = cfg_.grid.origin_m[0];
+  std::size_t window = 1;
+  if (cfg_.analysis.filter_window_s > 0) {
+    window = static_cast<std::size_t>(std::llround(cfg_.analysis.filter_window_s / sample_dt));
+    if (window % 2 == 0) ++window;
+  }
+  analysis::FrontFitOptions fo;
+  fo.wall_margin_m = 2.0 * h;
+  // The bed bottom is the longitudinal wall. k_l, k_t are defined at constant v_0: an intruder
+  // that ramps up to speed is fitted from the first sample whose (centred) time window lies
+  // after its ramp.
+  fo.t_begin_s = tb.cfg->ramp_time_s > 0 ? tb.cfg->ramp_time_s + 0.5 * static_cast<double>(window - 1) * sample_dt : 0.0;
+  auto fronts = [&](const std::vector<analysis::IntrusionFrame>& frames, const analysis::FrontCriterion& crit) {
+    nlohmann::json j;
+    const auto series = analysis::measure_front_series(frames, crit, geo, window);
+    j["series"] = analysis::to_json(series);
+    try {
+      const auto sp = analysis::front_speeds(series, std::fabs(v0), fo);
+      j["speeds"] = analysis::to_json(sp);
+    } catch (const InputError& e) {
+      j["speeds"] = nullptr;
+      j["fit_note"] = e.what();
+    }
+    return j;
+  };
+  nlohmann::json vel = fronts(uz_frames_, analysis::velocity_front(v0, cfg_.analysis.front_fraction));
+  out["velocity_front"] = vel;
+  if (!f_frames_.empty()) out["f_front"] = fronts(f_frames_, analysis::scalar_front(cfg_.analysis.f_threshold));
+  const nlohmann::json& sp = vel["speeds"];
+  for (const char* k : {"v_fl", "v_ft", "k_l", "k_t", "k_l_over_k_t"})
+    out[k] = sp.is_null() ? nlohmann::json(nullptr) : sp[k];
+  out["v0"] = std::fabs(v0);
+  out["ramp_time"] = tb.cfg->ramp_time_s;
+  out["filter_window_frames"] = window;
+  out["sample_interval"] = sample_dt;
+  return out;
+}
+
+}  // namespace
+
+template <class G>
+std::unique_ptr<SceneAnalysis<G>> make_intrusion_analysis(const scene::SceneConfig& config,
+                                                          const scene::BuiltScene<G>& scene) {
+  return std::make_unique<IntrusionAnalysis<G>>(config, scene);
+}
+
+OOBLECK_INSTANTIATE_ANALYSIS_MAKER(make_intrusion_analysis);
+
+}  // namespace oobleck::run

@@ -1,0 +1,26 @@
+#pragma once
+// What a run writes of the solver's state as it goes (docs/output.md): HDF5/XDMF frames of every
+// body's points and the nodal porosity, and the rows of series.csv. Writing reads the state and
+// changes nothing: the run loop samples its analyses itself.
+#include <string>
+#include <vector>
+
+#include "oobleck/io/frames.hpp"
+#include "oobleck/scene/build.hpp"
+
+namespace oobleck::run {
+
+/// Write one frame: per body its points' position, velocity, stress, pressure (fluid_pressure for
+/// the fluid), mass and volume; the grains' f, phi, tau_bar, regime, gamma_dot_p; the fluid's phi
+/// and J; and the nodal porosity on the physical nodes when there is a mixture.
+template <class G>
+void write_frame(io::FrameWriter& frames, const scene::BuiltScene<G>& scene);
+
+/// series.csv: time, step; per body its kinetic energy, momentum, mass and largest speed; per
+/// [[body]] entry its centre of mass and contact force, and its motor's ω and torque.
+template <class G>
+std::vector<std::string> series_columns(const scene::BuiltScene<G>& scene);
+template <class G>
+std::vector<double> series_row(const scene::BuiltScene<G>& scene);
+
+}  // namespace oobleck::run

@@ -1,0 +1,122 @@
+#include "oobleck/run/snapshots.hpp"
+
+#include <algorithm>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "oobleck/io/output_file.hpp"
+#include "oobleck/run/nodal_fields.hpp"
+#include "oobleck/run/solver_state.hpp"
+
+namespace oobleck::run {
+
+template <class G>
+Snapshots<G>::Snapshots(const scene::SceneConfig& config, const scene::BuiltScene<G>& scene, std::string out_dir)
+    : cfg_(config), scene_(scene), out_dir_(std::move(out_dir)) {
+  if (scene.grains >= 0) x0_grains_ = scene.solver->body(scene.grains).x_m;
+}
+
+template <class G>
+bool Snapshots<G>::due(bool final_step) const {
+  if constexpr (G::dim != 2) {
+    (void)final_step;
+    return false;  // the configuration allows snapshot_times on 2D grids only
+  } else {
+    const auto& times = cfg_.analysis.snapshot_times_s;
+    return next_ < times.size() && (scene_.solver->time_s() >= times[next_] - 0.5 * scene_.dt_s ||
+                                    (final_step && times[next_] <= cfg_.time.duration_s));
+  }
+}
+
+/// Nodal fields (bilinear, mass-weighted): mixture velocity, grain displacement since t = 0,
+/// structure f, granular pressure p~ (zero without grains).
+template <class G>
+SnapshotFields Snapshots<G>::fields() const {
+  SnapshotFields s;
+  if constexpr (G::dim == 2) {
+    auto& solver = *scene_.solver;
+    s.time_s = solver.time_s();
+    std::vector<const mpm::Body<G>*> mix;
+    for (int b : {scene_.grains, scene_.fluid})
+      if (b >= 0) mix.push_back(&solver.body(b));
+    const auto& grid = solver.grid();
+    auto vel = [&](int c) {
+      return nodal_average<G>(grid, mix, [&](std::size_t b, std::int64_t p) { return mix[b]->v_m_s[p][c]; });
+    };
+    s.u_x = vel(0);
+    s.u_y = vel(1);
+    if (scene_.grains >= 0) {
+      const auto& gb = solver.body(scene_.grains);
+      const auto* law = scene_.granular_law;
+      const std::vector<const mpm::Body<G>*> gs = {&gb};
+      auto displacement = [&](int a) {
+        return nodal_average<G>(grid, gs, [&](std::size_t, std::int64_t p) {
+          return mpm::periodic_difference<2>(grid, gb.x_m[p], x0_grains_[static_cast<std::size_t>(p)])[a];
+        });
+      };
+      s.displacement_x = displacement(0);
+      s.displacement_y = displacement(1);
+      s.f = nodal_average<G>(grid, gs, [&](std::size_t, std::int64_t p) { return law->f[static_cast<std::size_t>(p)]; });
+      s.p_grains = nodal_average<G>(grid, gs, [&](std::size_t, std::int64_t p) { return -gb.stress_Pa[p].trace() / 3.0; });
+    } else {
+      s.displacement_x = s.u_x;
+      std::fill(s.displacement_x.values.begin(), s.displacement_x.values.end(), 0.0);
+      s.displacement_y = s.f = s.p_grains = s.displacement_x;
+    }
+  }
+  return s;
+}
+
+template <class G>
+SnapshotFields Snapshots<G>::write_next() {
+  SnapshotFields s = fields();
+  if constexpr (G::dim == 2) {
+    auto& solver = *scene_.solver;
+    const auto& grid = solver.grid();
+    // phi = 1 - the step's nodal porosity (0 without a mixture).
+    const auto& n_nodal = solver.nodal_porosity();
+    std::string text = "x,y,u_x,u_y,displacement_x,displacement_y,f,p_grains,phi\n";
+    for (std::size_t j = 0; j < s.u_x.ny; ++j) {
+      for (std::size_t i = 0; i < s.u_x.nx; ++i) {
+        const std::size_t k = j * s.u_x.nx + i;
+        double phi = 0.0;
+        if (!n_nodal.empty()) {
+          const int flat = grid.storage_index(0, static_cast<int>(i)) * grid.stride(0) +
+                           grid.storage_index(1, static_cast<int>(j)) * grid.stride(1);
+          phi = 1.0 - n_nodal[static_cast<std::size_t>(flat)];
+        }
+        text += fmt::format("{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", s.u_x.x(i), s.u_x.y(j),
+                            s.u_x.values[k], s.u_y.values[k], s.displacement_x.values[k], s.displacement_y.values[k],
+                            s.f.values[k], s.p_grains.values[k], phi);
+      }
+    }
+    const std::string name = fmt::format("snapshot_{}.csv", next_);
+    io::write_file_atomically(out_dir_ + "/" + name,
+                              fmt::format("# t = {:.9g} s (requested {:.9g} s), step {}\n", solver.time_s(),
+                                          cfg_.analysis.snapshot_times_s[next_], solver.steps()) + text,
+                              "snapshot");
+    files_.push_back(name);
+    ++next_;
+  }
+  return s;
+}
+
+template <class G>
+void Snapshots<G>::save(io::CheckpointWriter& cp) const {
+  if (!x0_grains_.empty()) cp.array("analysis/x0_grains", as_doubles(x0_grains_));
+  cp.attribute("next_snapshot", static_cast<std::int64_t>(next_));
+}
+
+template <class G>
+void Snapshots<G>::restore(const io::Checkpoint& cp) {
+  if (!x0_grains_.empty()) cp.read_into("analysis/x0_grains", as_doubles(x0_grains_));
+  next_ = static_cast<std::size_t>(cp.int_attribute("next_snapshot"));
+  for (std::size_t k = 0; k < next_; ++k) files_.push_back(fmt::format("snapshot_{}.csv", k));
+}
+
+template class Snapshots<mpm::PlaneStrain>;
+template class Snapshots<mpm::Axisymmetric>;
+template class Snapshots<mpm::ThreeD>;
+
+}  // namespace oobleck::run

@@ -1,0 +1,49 @@
+#pragma once
+// Nodal-field snapshots at analysis.snapshot_times (docs/output.md "Snapshots"; 2D grids):
+// snapshot_<k>.csv with the mixture velocity, the grains' displacement since t = 0, f, p~ and phi
+// on the physical nodes. The grains' initial positions and the snapshot counter are checkpointed
+// ("analysis/x0_grains", attribute "next_snapshot").
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "oobleck/io/checkpoint.hpp"
+#include "oobleck/run/analysis.hpp"
+#include "oobleck/scene/build.hpp"
+
+namespace oobleck::run {
+
+template <class G>
+class Snapshots {
+ public:
+  /// Takes the grains' positions now as their initial positions (call before the first step).
+  Snapshots(const scene::SceneConfig& config, const scene::BuiltScene<G>& scene, std::string out_dir);
+
+  /// Whether the next snapshot is due: its time is reached (within half a step), or this is the
+  /// last step and the time lies within the run (times after the end of a shortened run are
+  /// skipped; the last step takes a time within half a step of the end).
+  bool due(bool final_step) const;
+  /// Write the next snapshot's file and return its fields.
+  SnapshotFields write_next();
+  /// The files written so far (for summary.json "snapshots").
+  const std::vector<std::string>& files() const { return files_; }
+
+  void save(io::CheckpointWriter& cp) const;
+  void restore(const io::Checkpoint& cp);
+
+ private:
+  SnapshotFields fields() const;
+
+  const scene::SceneConfig& cfg_;
+  const scene::BuiltScene<G>& scene_;
+  std::string out_dir_;
+  std::vector<mpm::Vec<G::dim>> x0_grains_;  ///< initial grain positions (displacements)
+  std::size_t next_ = 0;                     ///< index of the next snapshot time
+  std::vector<std::string> files_;
+};
+
+extern template class Snapshots<mpm::PlaneStrain>;
+extern template class Snapshots<mpm::Axisymmetric>;
+extern template class Snapshots<mpm::ThreeD>;
+
+}  // namespace oobleck::run
