@@ -176,81 +176,267 @@ constexpr std::array<std::pair<const char*, AnalysisKind>, 7> kAnalyses{{{"none"
                                                                         {"rod", AnalysisKind::Rod},
                                                                         {"wheel", AnalysisKind::Wheel}}};
 
-/// One [[body]] table (model.md §8 bodies).
-BodyConfig read_body(io::TomlReader& r, std::size_t index, const SceneConfig& c) {
-  const int dim = c.grid.dim;
-  const int ncomp = c.grid.geometry == Geometry::PlaneStrain ? 2 : 3;
-  BodyConfig b;
-  b.name = r.string_or("name", fmt::format("body{}", index));
-  if (b.name == "grains" || b.name == "fluid" || b.name.empty()) {
-    r.fail("name", fmt::format("= \"{}\": body names must be non-empty and differ from the phases \"grains\", \"fluid\"",
-                               b.name));
+// ---- One reader per section of the scene file, in the order load_scene calls them. Each
+// validates its keys as it reads them; the first error throws (file, key and reason), so the
+// order of the reads decides which of several errors is reported and is kept as it is.
+
+/// [scene]: the run's name (it names the folder out/<name>) and a description.
+void read_scene(io::TomlReader& top, SceneConfig& c) {
+  io::TomlReader sc = top.table("scene");
+  c.name = sc.string("name");
+  if (!io::is_plain_name(c.name))
+    sc.fail("name", fmt::format("= \"{}\": {} (it names the run folder out/<name>)", c.name, io::kPlainNameRule));
+  c.description = sc.string_or("description", "");
+  sc.finish();
+}
+
+/// [grid]: geometry, extent, square cells and the shape functions.
+GridConfig read_grid(io::TomlReader& top) {
+  io::TomlReader g = top.table("grid");
+  GridConfig grid;
+  grid.geometry = parse_enum(g, "geometry", Geometry::PlaneStrain, kGeometries);
+  grid.dim = grid.geometry == Geometry::ThreeD ? 3 : 2;
+  const int dim = grid.dim;
+  grid.origin_m = read_vec(g, "origin", dim, {0, 0, 0}, false);
+  grid.size_m = read_vec(g, "size", dim, {0, 0, 0}, true);
+  // Either cell_size [m] (size must be a whole number of cells) or cells along the first axis.
+  if (g.has("cells")) {
+    const auto n = read_vec(g, "cells", dim, {1, 1, 1}, true);
+    if (g.has("cell_size")) g.fail("cells", "give either grid.cells or grid.cell_size, not both");
+    (void)g.optional_number("cell_size");
+    g.require(n[0] >= 1 && n[0] == std::floor(n[0]), "cells", n[0], "entries must be whole numbers >= 1");
+    grid.cell_size_m = grid.size_m[0] / n[0];
+  } else {
+    grid.cell_size_m = g.number("cell_size");
   }
-  if (!io::is_plain_name(b.name)) r.fail("name", fmt::format("= \"{}\": {}", b.name, io::kPlainNameRule));
-  b.shape = parse_enum(r, "shape", BodyShape::Box, kBodyShapes);
-  b.motion = parse_enum(r, "motion", BodyMotionKind::Prescribed, kMotions);
+  g.require(grid.cell_size_m > 0.0 && std::isfinite(grid.cell_size_m), "cell_size", grid.cell_size_m,
+            "must be positive [m]");
+  for (int a = 0; a < dim; ++a) {
+    const double n = grid.size_m[a] / grid.cell_size_m;
+    g.require(grid.size_m[a] > 0.0, "size", grid.size_m[a], fmt::format("entry {} must be positive [m]", a));
+    g.require(std::fabs(n - std::round(n)) < 1e-6 * n, "size", grid.size_m[a],
+              fmt::format("entry {} must be a whole number of cells of size {} m (square cells)", a,
+                          grid.cell_size_m));
+    grid.cells[a] = static_cast<int>(std::lround(n));
+  }
+  if (grid.geometry == Geometry::Axisymmetric) {
+    g.require(grid.origin_m[0] >= 0.0, "origin", grid.origin_m[0], "axisymmetric: r_0 = origin[0] must be >= 0");
+  }
+  grid.shape = parse_enum(g, "shape_function", ShapeKind::Quadratic, kShapes);
+  g.finish();
+  return grid;
+}
+
+/// [material]: a preset or a params file (relative to the scene file), plus overrides.
+rheology::Preset read_material(io::TomlReader& top, const std::string& path) {
+  io::TomlReader m = top.table("material");
+  const std::string preset = m.string_or("preset", "");
+  const std::string params = m.string_or("params", "");
+  if (preset.empty() == params.empty()) m.fail("preset", "give exactly one of material.preset or material.params");
+  rheology::Preset material;
+  if (!preset.empty()) {
+    material = rheology::load_preset(preset);
+  } else {
+    const auto rel = std::filesystem::path(path).parent_path() / params;
+    material = rheology::load_params_file(std::filesystem::path(params).is_absolute() ? params : rel.string());
+  }
+  set_material_overrides(material, m);
+  m.finish();
+  rheology::validate(material, path + " [material]");
+  return material;
+}
+
+/// [fluid]; its eta_0 (default: the material's) becomes the material's too: one viscosity for
+/// both laws.
+void read_fluid(io::TomlReader& top, SceneConfig& c) {
+  if (auto f = top.optional_table("fluid")) {
+    c.fluid.rho_f0_kg_m3 = f->number_or("rho_f", c.fluid.rho_f0_kg_m3);
+    c.fluid.kappa_Pa = f->number_or("kappa", c.fluid.kappa_Pa);
+    c.fluid.eta_0_Pa_s = f->number_or("eta_0", c.material.steady.eta_0);
+    f->require(c.fluid.rho_f0_kg_m3 > 0, "rho_f", c.fluid.rho_f0_kg_m3, "must be positive [kg/m^3]");
+    f->require(c.fluid.kappa_Pa > 0, "kappa", c.fluid.kappa_Pa, "must be positive [Pa]");
+    f->require(c.fluid.eta_0_Pa_s > 0, "eta_0", c.fluid.eta_0_Pa_s, "must be positive [Pa s]");
+    f->finish();
+  } else {
+    c.fluid.eta_0_Pa_s = c.material.steady.eta_0;
+  }
+  c.material.steady.eta_0 = c.fluid.eta_0_Pa_s;
+}
+
+/// [coupling]: the drag law and the porosity clamp.
+CouplingConfig read_coupling(io::TomlReader& top) {
+  CouplingConfig coupling;
+  if (auto cp = top.optional_table("coupling")) {
+    constexpr std::array<std::pair<const char*, DragLaw>, 2> kDrag{
+        {{"beetstra", DragLaw::Beetstra}, {"carman_kozeny", DragLaw::CarmanKozeny}}};
+    coupling.drag = parse_enum(*cp, "drag", DragLaw::Beetstra, kDrag);
+    coupling.porosity_min = cp->number_or("porosity_min", coupling.porosity_min);
+    cp->require(coupling.porosity_min > 0 && coupling.porosity_min < 1, "porosity_min", coupling.porosity_min,
+                "must lie in (0, 1)");
+    cp->finish();
+  }
+  return coupling;
+}
+
+/// [transfer]: APIC or FLIP and the FLIP/PIC blend.
+TransferConfig read_transfer(io::TomlReader& top) {
+  TransferConfig transfer;
+  if (auto tr = top.optional_table("transfer")) {
+    constexpr std::array<std::pair<const char*, TransferScheme>, 2> kSchemes{
+        {{"apic", TransferScheme::Apic}, {"flip", TransferScheme::Flip}}};
+    transfer.scheme = parse_enum(*tr, "scheme", TransferScheme::Apic, kSchemes);
+    transfer.flip_fraction = tr->number_or("flip_fraction", transfer.flip_fraction);
+    tr->require(transfer.flip_fraction >= 0 && transfer.flip_fraction <= 1, "flip_fraction",
+                transfer.flip_fraction, "must lie in [0, 1]");
+    tr->finish();
+  }
+  return transfer;
+}
+
+/// One [[region]] table: a box of material points inside the grid.
+RegionConfig read_region(io::TomlReader& r, std::size_t index, const GridConfig& grid) {
+  const int dim = grid.dim;
+  RegionConfig reg;
+  reg.name = r.string_or("name", fmt::format("region{}", index));
+  reg.phase = parse_enum(r, "phase", Phase::Mixture, kPhases);
+  reg.min_m = read_vec(r, "min", dim, {0, 0, 0}, true);
+  reg.max_m = read_vec(r, "max", dim, {0, 0, 0}, true);
+  for (int a = 0; a < dim; ++a) {
+    r.require(reg.max_m[a] > reg.min_m[a], "max", reg.max_m[a], fmt::format("entry {} must exceed min[{}]", a, a));
+    r.require(reg.min_m[a] >= grid.origin_m[a] - 1e-12 && reg.max_m[a] <= grid.origin_m[a] + grid.size_m[a] + 1e-12,
+              "max", reg.max_m[a], fmt::format("the box must lie inside the grid along axis {}", a));
+  }
+  const bool has_grains = reg.phase == Phase::Mixture || reg.phase == Phase::Grains;
+  reg.phi = has_grains ? r.number("phi") : r.number_or("phi", 0.0);
+  if (has_grains) {
+    r.require(reg.phi > 0 && reg.phi < 1, "phi", reg.phi, "must lie in (0, 1)");
+  }
+  reg.points_per_cell = static_cast<int>(r.number_or("points_per_cell", 2));
+  r.require(reg.points_per_cell >= 1 && reg.points_per_cell <= 8, "points_per_cell", reg.points_per_cell,
+            "must be an integer in [1, 8] (per axis)");
+  const int ncomp = grid.geometry == Geometry::PlaneStrain ? 2 : 3;
+  reg.velocity_m_s = read_vec(r, "velocity", ncomp, {0, 0, 0}, false, dim);
+  constexpr std::array<std::pair<const char*, InitialState>, 3> kInit{
+      {{"at_rest", InitialState::AtRest}, {"hydrostatic", InitialState::Hydrostatic},
+       {"suspended", InitialState::Suspended}}};
+  reg.initial_state = parse_enum(r, "initial_state", InitialState::AtRest, kInit);
+  if (reg.phase == Phase::Elastic) {
+    reg.elastic.density_kg_m3 = r.number("density");
+    reg.elastic.youngs_modulus_Pa = r.number("youngs_modulus");
+    reg.elastic.poisson_ratio = r.number_or("poisson_ratio", 0.3);
+    r.require(reg.elastic.density_kg_m3 > 0, "density", reg.elastic.density_kg_m3, "must be positive [kg/m^3]");
+    r.require(reg.elastic.youngs_modulus_Pa > 0, "youngs_modulus", reg.elastic.youngs_modulus_Pa,
+              "must be positive [Pa]");
+    r.require(reg.elastic.poisson_ratio > -1 && reg.elastic.poisson_ratio < 0.5, "poisson_ratio",
+              reg.elastic.poisson_ratio, "must lie in (-1, 0.5)");
+  }
+  r.finish();
+  return reg;
+}
+
+/// [[region]]: at least one.
+std::vector<RegionConfig> read_regions(io::TomlReader& top, const GridConfig& grid) {
+  auto regions = top.table_array("region");
+  if (regions.empty()) top.fail("region", "missing: at least one [[region]] of material points is required");
+  std::vector<RegionConfig> out;
+  for (std::size_t i = 0; i < regions.size(); ++i) out.push_back(read_region(regions[i], i, grid));
+  return out;
+}
+
+/// One face's table of [boundary] (x_min, ...). `axis_face`: the face r = 0 of an axisymmetric
+/// grid, which must be (and is the only one that may be) of type "axis".
+void read_face(io::TomlReader& fb, const GridConfig& grid, bool axis_face, BoundaryConfig& bc) {
+  bc.type = parse_enum(fb, "type", BoundaryType::NoSlip, kBoundaries);
+  if (bc.type == BoundaryType::Friction) {
+    bc.friction = fb.number("friction");
+    fb.require(bc.friction >= 0, "friction", bc.friction, "must be >= 0");
+  }
+  if (bc.type == BoundaryType::Velocity) {
+    const int ncomp = grid.geometry == Geometry::PlaneStrain ? 2 : 3;
+    bc.velocity_m_s = read_vec(fb, "velocity", ncomp, {0, 0, 0}, true, grid.dim);
+  }
+  if (axis_face != (bc.type == BoundaryType::Axis)) {
+    fb.fail("type", axis_face ? "the face r = 0 of an axisymmetric grid is the axis: type must be \"axis\""
+                              : "type \"axis\" is only valid for x_min of an axisymmetric grid with origin r = 0");
+  }
+  fb.finish();
+}
+
+/// [boundary]: one table per face (default no-slip); on the axis of an axisymmetric grid
+/// (r_0 = 0) only v_r and v_theta vanish. Periodic faces come in pairs, never on the axis.
+std::array<BoundaryConfig, 6> read_boundary(io::TomlReader& top, const std::string& path, const GridConfig& grid) {
+  std::array<BoundaryConfig, 6> boundary;
+  const int dim = grid.dim;
+  const bool on_axis = grid.geometry == Geometry::Axisymmetric && grid.origin_m[0] == 0.0;
+  if (on_axis) boundary[0].type = BoundaryType::Axis;
+  if (auto b = top.optional_table("boundary")) {
+    for (int face = 0; face < 2 * dim; ++face) {
+      if (auto fb = b->optional_table(face_names()[face])) read_face(*fb, grid, on_axis && face == 0, boundary[face]);
+    }
+    b->finish();
+  }
+  for (int a = 0; a < dim; ++a) {
+    const bool lo = boundary[2 * a].type == BoundaryType::Periodic;
+    const bool hi = boundary[2 * a + 1].type == BoundaryType::Periodic;
+    if (lo != hi) {
+      throw InputError(fmt::format("{}: key 'boundary.{}': periodic faces come in pairs ({} and {})", path,
+                                   face_names()[2 * a], face_names()[2 * a], face_names()[2 * a + 1]));
+    }
+  }
+  if (grid.geometry == Geometry::Axisymmetric && boundary[0].type == BoundaryType::Periodic) {
+    throw InputError(fmt::format("{}: key 'boundary.x_min': the radial axis cannot be periodic", path));
+  }
+  return boundary;
+}
+
+/// A [[body]]'s shape: a box, or (plane strain) a disc or a paddle wheel, inside the grid along
+/// every axis that is not periodic.
+void read_body_shape(io::TomlReader& r, const SceneConfig& c, BodyConfig& b) {
+  const int dim = c.grid.dim;
   auto inside_grid = [&](std::string_view key, double lo, double hi, int a) {
     r.require(lo >= c.grid.origin_m[a] - 1e-12 && hi <= c.grid.origin_m[a] + c.grid.size_m[a] + 1e-12, key, hi,
               fmt::format("the body must lie inside the grid along axis {}", a));
   };
-  switch (b.shape) {
-    case BodyShape::Box:
-      b.min_m = read_vec(r, "min", dim, {0, 0, 0}, true);
-      b.max_m = read_vec(r, "max", dim, {0, 0, 0}, true);
-      for (int a = 0; a < dim; ++a) {
-        r.require(b.max_m[a] > b.min_m[a], "max", b.max_m[a], fmt::format("entry {} must exceed min[{}]", a, a));
-        if (!(c.boundary[2 * a].type == BoundaryType::Periodic)) inside_grid("max", b.min_m[a], b.max_m[a], a);
-      }
-      break;
-    case BodyShape::Disc:
-    case BodyShape::Wheel: {
-      if (c.grid.geometry != Geometry::PlaneStrain) {
-        r.fail("shape", "discs and wheels are plane-strain bodies (use a box: a cylinder on the axis)");
-      }
-      b.centre_m = read_vec(r, "centre", dim, {0, 0, 0}, true);
-      double R = 0.0;
-      if (b.shape == BodyShape::Disc) {
-        b.radius_m = r.number("radius");
-        r.require(b.radius_m > 0, "radius", b.radius_m, "must be positive [m]");
-        R = b.radius_m;
-      } else {
-        b.hub_radius_m = r.number("hub_radius");
-        b.paddle_length_m = r.number("paddle_length");
-        b.paddle_width_m = r.number("paddle_width");
-        const double np = r.number_or("paddles", 4);
-        b.angle_deg = r.number_or("angle", 0.0);
-        r.require(b.hub_radius_m > 0, "hub_radius", b.hub_radius_m, "must be positive [m]");
-        r.require(b.paddle_length_m >= 0, "paddle_length", b.paddle_length_m, "must be >= 0 [m]");
-        r.require(b.paddle_width_m > 0 && b.paddle_width_m <= 2 * b.hub_radius_m, "paddle_width", b.paddle_width_m,
-                  "must lie in (0, 2 hub_radius] [m]");
-        r.require(np >= 1 && np <= 32 && np == std::floor(np), "paddles", np, "must be a whole number in [1, 32]");
-        b.paddles = static_cast<int>(np);
-        R = b.hub_radius_m + b.paddle_length_m;
-      }
-      for (int a = 0; a < dim; ++a) {
-        if (!(c.boundary[2 * a].type == BoundaryType::Periodic)) inside_grid("centre", b.centre_m[a] - R, b.centre_m[a] + R, a);
-      }
-      break;
+  if (b.shape == BodyShape::Box) {
+    b.min_m = read_vec(r, "min", dim, {0, 0, 0}, true);
+    b.max_m = read_vec(r, "max", dim, {0, 0, 0}, true);
+    for (int a = 0; a < dim; ++a) {
+      r.require(b.max_m[a] > b.min_m[a], "max", b.max_m[a], fmt::format("entry {} must exceed min[{}]", a, a));
+      if (!(c.boundary[2 * a].type == BoundaryType::Periodic)) inside_grid("max", b.min_m[a], b.max_m[a], a);
     }
+    return;
   }
-  b.velocity_m_s = read_vec(r, "velocity", ncomp, {0, 0, 0}, false, dim);
-  if (auto speed = r.optional_number("speed")) {
-    // speed [m/s] along the direction of `velocity` (then only a direction): --set v0=0.5
-    r.require(*speed >= 0, "speed", *speed, "must be >= 0 [m/s] (the direction is given by velocity)");
-    double n2 = 0.0;
-    for (double v : b.velocity_m_s) n2 += v * v;
-    if (!(n2 > 0)) r.fail("speed", "needs a non-zero `velocity` giving the direction of motion");
-    for (double& v : b.velocity_m_s) v *= *speed / std::sqrt(n2);
+  if (c.grid.geometry != Geometry::PlaneStrain) {
+    r.fail("shape", "discs and wheels are plane-strain bodies (use a box: a cylinder on the axis)");
   }
-  if (r.has("ramp_time") && b.motion != BodyMotionKind::Prescribed)
-    r.fail("ramp_time", "only a prescribed body (motion = \"prescribed\") takes a ramp_time");
-  b.ramp_time_s = r.number_or("ramp_time", 0.0);
-  r.require(b.ramp_time_s >= 0 && std::isfinite(b.ramp_time_s), "ramp_time", b.ramp_time_s, "must be >= 0 and finite [s]");
-  b.points_per_cell = static_cast<int>(r.number_or("points_per_cell", 2));
-  r.require(b.points_per_cell >= 1 && b.points_per_cell <= 8, "points_per_cell", b.points_per_cell,
-            "must be an integer in [1, 8] (per axis)");
-  b.friction = r.number_or("friction", 0.0);
-  r.require(b.friction >= 0, "friction", b.friction, "must be >= 0 (Coulomb coefficient with the grains)");
+  b.centre_m = read_vec(r, "centre", dim, {0, 0, 0}, true);
+  double R = 0.0;
+  if (b.shape == BodyShape::Disc) {
+    b.radius_m = r.number("radius");
+    r.require(b.radius_m > 0, "radius", b.radius_m, "must be positive [m]");
+    R = b.radius_m;
+  } else {
+    b.hub_radius_m = r.number("hub_radius");
+    b.paddle_length_m = r.number("paddle_length");
+    b.paddle_width_m = r.number("paddle_width");
+    const double np = r.number_or("paddles", 4);
+    b.angle_deg = r.number_or("angle", 0.0);
+    r.require(b.hub_radius_m > 0, "hub_radius", b.hub_radius_m, "must be positive [m]");
+    r.require(b.paddle_length_m >= 0, "paddle_length", b.paddle_length_m, "must be >= 0 [m]");
+    r.require(b.paddle_width_m > 0 && b.paddle_width_m <= 2 * b.hub_radius_m, "paddle_width", b.paddle_width_m,
+              "must lie in (0, 2 hub_radius] [m]");
+    r.require(np >= 1 && np <= 32 && np == std::floor(np), "paddles", np, "must be a whole number in [1, 32]");
+    b.paddles = static_cast<int>(np);
+    R = b.hub_radius_m + b.paddle_length_m;
+  }
+  for (int a = 0; a < dim; ++a) {
+    if (!(c.boundary[2 * a].type == BoundaryType::Periodic)) inside_grid("centre", b.centre_m[a] - R, b.centre_m[a] + R, a);
+  }
+}
+
+/// A [[body]]'s mass (free rigid bodies: mass or density) and, for an elastic body, its moduli and
+/// motor; the elastic keys are refused on the other bodies.
+void read_body_material(io::TomlReader& r, const SceneConfig& c, BodyConfig& b) {
   b.mass_kg = r.optional_number("mass");
   if (b.mass_kg) {
     r.require(*b.mass_kg > 0, "mass", *b.mass_kg, "must be positive [kg]");
@@ -277,8 +463,183 @@ BodyConfig read_body(io::TomlReader& r, std::size_t index, const SceneConfig& c)
       if (r.has(k)) r.fail(k, fmt::format("only an elastic body (motion = \"elastic\") takes {}", k));
     }
   }
+}
+
+/// One [[body]] table (model.md §8 bodies).
+BodyConfig read_body(io::TomlReader& r, std::size_t index, const SceneConfig& c) {
+  const int ncomp = c.grid.geometry == Geometry::PlaneStrain ? 2 : 3;
+  BodyConfig b;
+  b.name = r.string_or("name", fmt::format("body{}", index));
+  if (b.name == "grains" || b.name == "fluid" || b.name.empty()) {
+    r.fail("name", fmt::format("= \"{}\": body names must be non-empty and differ from the phases \"grains\", \"fluid\"",
+                               b.name));
+  }
+  if (!io::is_plain_name(b.name)) r.fail("name", fmt::format("= \"{}\": {}", b.name, io::kPlainNameRule));
+  b.shape = parse_enum(r, "shape", BodyShape::Box, kBodyShapes);
+  b.motion = parse_enum(r, "motion", BodyMotionKind::Prescribed, kMotions);
+  read_body_shape(r, c, b);
+  b.velocity_m_s = read_vec(r, "velocity", ncomp, {0, 0, 0}, false, c.grid.dim);
+  if (auto speed = r.optional_number("speed")) {
+    // speed [m/s] along the direction of `velocity` (then only a direction): --set v0=0.5
+    r.require(*speed >= 0, "speed", *speed, "must be >= 0 [m/s] (the direction is given by velocity)");
+    double n2 = 0.0;
+    for (double v : b.velocity_m_s) n2 += v * v;
+    if (!(n2 > 0)) r.fail("speed", "needs a non-zero `velocity` giving the direction of motion");
+    for (double& v : b.velocity_m_s) v *= *speed / std::sqrt(n2);
+  }
+  if (r.has("ramp_time") && b.motion != BodyMotionKind::Prescribed)
+    r.fail("ramp_time", "only a prescribed body (motion = \"prescribed\") takes a ramp_time");
+  b.ramp_time_s = r.number_or("ramp_time", 0.0);
+  r.require(b.ramp_time_s >= 0 && std::isfinite(b.ramp_time_s), "ramp_time", b.ramp_time_s, "must be >= 0 and finite [s]");
+  b.points_per_cell = static_cast<int>(r.number_or("points_per_cell", 2));
+  r.require(b.points_per_cell >= 1 && b.points_per_cell <= 8, "points_per_cell", b.points_per_cell,
+            "must be an integer in [1, 8] (per axis)");
+  b.friction = r.number_or("friction", 0.0);
+  r.require(b.friction >= 0, "friction", b.friction, "must be >= 0 (Coulomb coefficient with the grains)");
+  read_body_material(r, c, b);
   r.finish();
   return b;
+}
+
+/// [[body]]: solid third bodies (model.md §8) with distinct names; needs the grid and the
+/// boundary (a body may cross a periodic pair of faces).
+std::vector<BodyConfig> read_bodies(io::TomlReader& top, const SceneConfig& c) {
+  auto bodies = top.table_array("body");
+  std::vector<BodyConfig> out;
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    out.push_back(read_body(bodies[i], i, c));
+    for (std::size_t j = 0; j < i; ++j) {
+      if (out[j].name == out[i].name) bodies[i].fail("name", fmt::format("= \"{}\" is used twice", out[i].name));
+    }
+  }
+  return out;
+}
+
+/// [physics]: gravity [m/s^2] (default none).
+std::array<double, 3> read_physics(io::TomlReader& top, const GridConfig& grid) {
+  std::array<double, 3> gravity{0, 0, 0};
+  if (auto ph = top.optional_table("physics")) {
+    gravity = read_vec(*ph, "gravity", grid.dim, {0, 0, 0}, false);
+    ph->finish();
+  }
+  return gravity;
+}
+
+/// [time]: duration, an optional fixed dt, the CFL fraction.
+TimeConfig read_time(io::TomlReader& top) {
+  io::TomlReader t = top.table("time");
+  TimeConfig time;
+  time.duration_s = t.number("duration");
+  t.require(time.duration_s > 0 && std::isfinite(time.duration_s), "duration", time.duration_s, "must be positive [s]");
+  time.dt_s = t.optional_number("dt");
+  if (time.dt_s) t.require(*time.dt_s > 0, "dt", *time.dt_s, "must be positive [s]");
+  time.cfl = t.number_or("cfl", time.cfl);
+  t.require(time.cfl > 0 && time.cfl <= 1, "cfl", time.cfl, "must lie in (0, 1]");
+  t.finish();
+  return time;
+}
+
+/// [output]: frame and series intervals, checkpoints every so many steps.
+OutputConfig read_output(io::TomlReader& top) {
+  OutputConfig output;
+  if (auto o = top.optional_table("output")) {
+    output.frame_interval_s = o->number_or("frame_interval", 0.0);
+    output.series_interval_s = o->number_or("series_interval", 0.0);
+    const double ce = o->number_or("checkpoint_every", 0.0);
+    o->require(output.frame_interval_s >= 0, "frame_interval", output.frame_interval_s, "must be >= 0 [s]");
+    o->require(output.series_interval_s >= 0, "series_interval", output.series_interval_s, "must be >= 0 [s]");
+    o->require(ce >= 0 && ce == std::floor(ce), "checkpoint_every", ce, "must be a whole number of steps >= 0");
+    output.checkpoint_every = static_cast<long>(ce);
+    o->finish();
+  }
+  return output;
+}
+
+/// analysis.snapshot_times: increasing times >= 0 [s], 2D grids only.
+std::vector<double> read_snapshot_times(io::TomlReader& an, const GridConfig& grid) {
+  std::vector<double> times;
+  const toml::array* arr = an.raw("snapshot_times")->as_array();
+  if (arr == nullptr) an.fail("snapshot_times", "must be an array of times [s]");
+  for (std::size_t i = 0; i < arr->size(); ++i) {
+    const auto v = (*arr)[i].value<double>();
+    if (!v) an.fail("snapshot_times", fmt::format("entry {} is not a number", i));
+    an.require(*v >= 0, "snapshot_times", *v, "entries must be >= 0 [s] (times after the run's end are skipped)");
+    if (i > 0) an.require(*v > times.back(), "snapshot_times", *v, "entries must increase");
+    times.push_back(*v);
+  }
+  if (grid.dim != 2) an.fail("snapshot_times", "nodal-field snapshots are written for 2D grids only");
+  return times;
+}
+
+/// The body of the intrusion, rod and wheel analyses (default: the first [[body]]) and whether the
+/// set-up suits the kind; the other kinds take no body.
+void check_analysis_body(io::TomlReader& an, const SceneConfig& c, AnalysisConfig& analysis) {
+  const bool needs_body = analysis.kind == AnalysisKind::Intrusion || analysis.kind == AnalysisKind::Rod ||
+                          analysis.kind == AnalysisKind::Wheel;
+  if (!needs_body) {
+    if (!analysis.body.empty()) an.fail("body", fmt::format("is only used by the intrusion, rod and wheel analyses"));
+    return;
+  }
+  if (c.bodies.empty()) an.fail("kind", fmt::format("\"{}\" needs a [[body]]", to_string(analysis.kind)));
+  if (analysis.body.empty()) analysis.body = c.bodies.front().name;
+  const BodyConfig* target = nullptr;
+  for (const auto& b : c.bodies)
+    if (b.name == analysis.body) target = &b;
+  if (target == nullptr) an.fail("body", fmt::format("= \"{}\": no [[body]] has that name", analysis.body));
+  const bool axi = c.grid.geometry == Geometry::Axisymmetric;
+  if (analysis.kind == AnalysisKind::Intrusion && !(axi && target->motion == BodyMotionKind::Prescribed)) {
+    an.fail("kind", "\"intrusion\" needs an axisymmetric grid and a prescribed-velocity body");
+  }
+  if (analysis.kind == AnalysisKind::Rod && target->motion != BodyMotionKind::Free) {
+    an.fail("kind", "\"rod\" needs a free rigid body (motion = \"free\")");
+  }
+  if (analysis.kind == AnalysisKind::Wheel &&
+      !(c.grid.geometry == Geometry::PlaneStrain && target->motion == BodyMotionKind::Elastic)) {
+    an.fail("kind", "\"wheel\" needs a plane-strain grid and an elastic body");
+  }
+}
+
+/// [analysis]: the built-in measurement; needs the grid, boundary, bodies and duration read.
+AnalysisConfig read_analysis(io::TomlReader& top, const SceneConfig& c) {
+  AnalysisConfig analysis;
+  auto an = top.optional_table("analysis");
+  if (!an) return analysis;
+  analysis.kind = parse_enum(*an, "kind", AnalysisKind::None, kAnalyses);
+  analysis.average_from_s = an->number_or("average_from", 0.0);
+  an->require(analysis.average_from_s >= 0 && analysis.average_from_s < c.time.duration_s, "average_from",
+              analysis.average_from_s, "must lie in [0, time.duration) [s]");
+  analysis.sample_interval_s = an->number_or("sample_interval", 0.0);
+  an->require(analysis.sample_interval_s >= 0, "sample_interval", analysis.sample_interval_s, "must be >= 0 [s]");
+  if (auto z = an->optional_number("sample_z")) analysis.sample_z_m = *z;
+  if (analysis.kind == AnalysisKind::Annular &&
+      (c.grid.geometry != Geometry::Axisymmetric || c.boundary[0].type != BoundaryType::Velocity)) {
+    an->fail("kind", "\"annular\" needs an axisymmetric grid whose x_min face is a velocity wall (the bob)");
+  }
+  analysis.body = an->string_or("body", "");
+  analysis.filter_window_s = an->number_or("filter_window", 0.0);
+  an->require(analysis.filter_window_s >= 0, "filter_window", analysis.filter_window_s, "must be >= 0 [s]");
+  analysis.front_fraction = an->number_or("front_fraction", 0.5);
+  an->require(analysis.front_fraction > 0 && analysis.front_fraction < 1, "front_fraction", analysis.front_fraction,
+              "must lie in (0, 1)");
+  analysis.f_threshold = an->number_or("f_threshold", 0.5);
+  an->require(analysis.f_threshold > 0 && analysis.f_threshold < 1, "f_threshold", analysis.f_threshold,
+              "must lie in (0, 1)");
+  if (an->has("snapshot_times")) analysis.snapshot_times_s = read_snapshot_times(*an, c.grid);
+  check_analysis_body(*an, c, analysis);
+  an->finish();
+  return analysis;
+}
+
+/// [aliases]: short names for --set, string key paths.
+std::map<std::string, std::string> read_aliases(const toml::table& root, const std::string& path) {
+  std::map<std::string, std::string> aliases;
+  if (const auto* al = root.get_as<toml::table>("aliases")) {
+    for (const auto& [k, v] : *al) {
+      if (!v.is_string()) throw InputError(fmt::format("{}: key 'aliases.{}': must be a string key path", path, k.str()));
+      aliases[std::string(k.str())] = *v.value<std::string>();
+    }
+  }
+  return aliases;
 }
 
 template <class E, std::size_t N>
@@ -307,16 +668,9 @@ SceneConfig load_scene(const std::string& path, const std::vector<std::string>& 
   toml::table root = io::parse_toml_file(path);
   SceneConfig c;
   c.file = path;
-
   // Aliases first: they give --set its short names.
-  if (auto* al = root.get_as<toml::table>("aliases")) {
-    for (const auto& [k, v] : *al) {
-      if (!v.is_string()) throw InputError(fmt::format("{}: key 'aliases.{}': must be a string key path", path, k.str()));
-      c.aliases[std::string(k.str())] = *v.value<std::string>();
-    }
-  }
+  c.aliases = read_aliases(root, path);
   for (const auto& o : overrides) apply_override(root, path, o, c.aliases);
-
   {
     std::ostringstream resolved;
     resolved << root;
@@ -324,276 +678,21 @@ SceneConfig load_scene(const std::string& path, const std::vector<std::string>& 
   }
   io::TomlReader top(root, path);
   (void)top.optional_table("aliases");
-
-  io::TomlReader sc = top.table("scene");
-  c.name = sc.string("name");
-  if (!io::is_plain_name(c.name))
-    sc.fail("name", fmt::format("= \"{}\": {} (it names the run folder out/<name>)", c.name, io::kPlainNameRule));
-  c.description = sc.string_or("description", "");
-  sc.finish();
-
-  // [grid]
-  io::TomlReader g = top.table("grid");
-  c.grid.geometry = parse_enum(g, "geometry", Geometry::PlaneStrain, kGeometries);
-  c.grid.dim = c.grid.geometry == Geometry::ThreeD ? 3 : 2;
-  const int dim = c.grid.dim;
-  c.grid.origin_m = read_vec(g, "origin", dim, {0, 0, 0}, false);
-  c.grid.size_m = read_vec(g, "size", dim, {0, 0, 0}, true);
-  // Either cell_size [m] (size must be a whole number of cells) or cells along the first axis.
-  if (g.has("cells")) {
-    const auto n = read_vec(g, "cells", dim, {1, 1, 1}, true);
-    if (g.has("cell_size")) g.fail("cells", "give either grid.cells or grid.cell_size, not both");
-    (void)g.optional_number("cell_size");
-    g.require(n[0] >= 1 && n[0] == std::floor(n[0]), "cells", n[0], "entries must be whole numbers >= 1");
-    c.grid.cell_size_m = c.grid.size_m[0] / n[0];
-  } else {
-    c.grid.cell_size_m = g.number("cell_size");
-  }
-  g.require(c.grid.cell_size_m > 0.0 && std::isfinite(c.grid.cell_size_m), "cell_size", c.grid.cell_size_m,
-            "must be positive [m]");
-  for (int a = 0; a < dim; ++a) {
-    const double n = c.grid.size_m[a] / c.grid.cell_size_m;
-    g.require(c.grid.size_m[a] > 0.0, "size", c.grid.size_m[a], fmt::format("entry {} must be positive [m]", a));
-    g.require(std::fabs(n - std::round(n)) < 1e-6 * n, "size", c.grid.size_m[a],
-              fmt::format("entry {} must be a whole number of cells of size {} m (square cells)", a,
-                          c.grid.cell_size_m));
-    c.grid.cells[a] = static_cast<int>(std::lround(n));
-  }
-  if (c.grid.geometry == Geometry::Axisymmetric) {
-    g.require(c.grid.origin_m[0] >= 0.0, "origin", c.grid.origin_m[0], "axisymmetric: r_0 = origin[0] must be >= 0");
-  }
-  c.grid.shape = parse_enum(g, "shape_function", ShapeKind::Quadratic, kShapes);
-  g.finish();
-
-  // [material]: preset or params file, plus overrides
-  io::TomlReader m = top.table("material");
-  const std::string preset = m.string_or("preset", "");
-  const std::string params = m.string_or("params", "");
-  if (preset.empty() == params.empty()) m.fail("preset", "give exactly one of material.preset or material.params");
-  if (!preset.empty()) {
-    c.material = rheology::load_preset(preset);
-  } else {
-    const auto rel = std::filesystem::path(path).parent_path() / params;
-    c.material = rheology::load_params_file(std::filesystem::path(params).is_absolute() ? params : rel.string());
-  }
-  set_material_overrides(c.material, m);
-  m.finish();
-  rheology::validate(c.material, path + " [material]");
-
-  // [fluid]
-  if (auto f = top.optional_table("fluid")) {
-    c.fluid.rho_f0_kg_m3 = f->number_or("rho_f", c.fluid.rho_f0_kg_m3);
-    c.fluid.kappa_Pa = f->number_or("kappa", c.fluid.kappa_Pa);
-    c.fluid.eta_0_Pa_s = f->number_or("eta_0", c.material.steady.eta_0);
-    f->require(c.fluid.rho_f0_kg_m3 > 0, "rho_f", c.fluid.rho_f0_kg_m3, "must be positive [kg/m^3]");
-    f->require(c.fluid.kappa_Pa > 0, "kappa", c.fluid.kappa_Pa, "must be positive [Pa]");
-    f->require(c.fluid.eta_0_Pa_s > 0, "eta_0", c.fluid.eta_0_Pa_s, "must be positive [Pa s]");
-    f->finish();
-  } else {
-    c.fluid.eta_0_Pa_s = c.material.steady.eta_0;
-  }
-  c.material.steady.eta_0 = c.fluid.eta_0_Pa_s;  // one viscosity for both laws
-
-  // [coupling]
-  if (auto cp = top.optional_table("coupling")) {
-    constexpr std::array<std::pair<const char*, DragLaw>, 2> kDrag{
-        {{"beetstra", DragLaw::Beetstra}, {"carman_kozeny", DragLaw::CarmanKozeny}}};
-    c.coupling.drag = parse_enum(*cp, "drag", DragLaw::Beetstra, kDrag);
-    c.coupling.porosity_min = cp->number_or("porosity_min", c.coupling.porosity_min);
-    cp->require(c.coupling.porosity_min > 0 && c.coupling.porosity_min < 1, "porosity_min", c.coupling.porosity_min,
-                "must lie in (0, 1)");
-    cp->finish();
-  }
-
-  // [transfer]
-  if (auto tr = top.optional_table("transfer")) {
-    constexpr std::array<std::pair<const char*, TransferScheme>, 2> kSchemes{
-        {{"apic", TransferScheme::Apic}, {"flip", TransferScheme::Flip}}};
-    c.transfer.scheme = parse_enum(*tr, "scheme", TransferScheme::Apic, kSchemes);
-    c.transfer.flip_fraction = tr->number_or("flip_fraction", c.transfer.flip_fraction);
-    tr->require(c.transfer.flip_fraction >= 0 && c.transfer.flip_fraction <= 1, "flip_fraction",
-                c.transfer.flip_fraction, "must lie in [0, 1]");
-    tr->finish();
-  }
-
-  // [[region]]
-  auto regions = top.table_array("region");
-  if (regions.empty()) top.fail("region", "missing: at least one [[region]] of material points is required");
-  for (std::size_t i = 0; i < regions.size(); ++i) {
-    io::TomlReader& r = regions[i];
-    RegionConfig reg;
-    reg.name = r.string_or("name", fmt::format("region{}", i));
-    reg.phase = parse_enum(r, "phase", Phase::Mixture, kPhases);
-    reg.min_m = read_vec(r, "min", dim, {0, 0, 0}, true);
-    reg.max_m = read_vec(r, "max", dim, {0, 0, 0}, true);
-    for (int a = 0; a < dim; ++a) {
-      r.require(reg.max_m[a] > reg.min_m[a], "max", reg.max_m[a], fmt::format("entry {} must exceed min[{}]", a, a));
-      r.require(reg.min_m[a] >= c.grid.origin_m[a] - 1e-12 &&
-                    reg.max_m[a] <= c.grid.origin_m[a] + c.grid.size_m[a] + 1e-12,
-                "max", reg.max_m[a], fmt::format("the box must lie inside the grid along axis {}", a));
-    }
-    const bool has_grains = reg.phase == Phase::Mixture || reg.phase == Phase::Grains;
-    reg.phi = has_grains ? r.number("phi") : r.number_or("phi", 0.0);
-    if (has_grains) {
-      r.require(reg.phi > 0 && reg.phi < 1, "phi", reg.phi, "must lie in (0, 1)");
-    }
-    reg.points_per_cell = static_cast<int>(r.number_or("points_per_cell", 2));
-    r.require(reg.points_per_cell >= 1 && reg.points_per_cell <= 8, "points_per_cell", reg.points_per_cell,
-              "must be an integer in [1, 8] (per axis)");
-    const int ncomp = c.grid.geometry == Geometry::PlaneStrain ? 2 : 3;
-    reg.velocity_m_s = read_vec(r, "velocity", ncomp, {0, 0, 0}, false, dim);
-    constexpr std::array<std::pair<const char*, InitialState>, 3> kInit{
-        {{"at_rest", InitialState::AtRest},
-         {"hydrostatic", InitialState::Hydrostatic},
-         {"suspended", InitialState::Suspended}}};
-    reg.initial_state = parse_enum(r, "initial_state", InitialState::AtRest, kInit);
-    if (reg.phase == Phase::Elastic) {
-      reg.elastic.density_kg_m3 = r.number("density");
-      reg.elastic.youngs_modulus_Pa = r.number("youngs_modulus");
-      reg.elastic.poisson_ratio = r.number_or("poisson_ratio", 0.3);
-      r.require(reg.elastic.density_kg_m3 > 0, "density", reg.elastic.density_kg_m3, "must be positive [kg/m^3]");
-      r.require(reg.elastic.youngs_modulus_Pa > 0, "youngs_modulus", reg.elastic.youngs_modulus_Pa,
-                "must be positive [Pa]");
-      r.require(reg.elastic.poisson_ratio > -1 && reg.elastic.poisson_ratio < 0.5, "poisson_ratio",
-                reg.elastic.poisson_ratio, "must lie in (-1, 0.5)");
-    }
-    r.finish();
-    c.regions.push_back(reg);
-  }
-
-  // [boundary]; on the axis of an axisymmetric grid (r_0 = 0) only v_r and v_theta vanish.
-  const bool on_axis = c.grid.geometry == Geometry::Axisymmetric && c.grid.origin_m[0] == 0.0;
-  if (on_axis) c.boundary[0].type = BoundaryType::Axis;
-  if (auto b = top.optional_table("boundary")) {
-    for (int face = 0; face < 2 * dim; ++face) {
-      const char* fname = face_names()[face];
-      auto fb = b->optional_table(fname);
-      if (!fb) continue;
-      BoundaryConfig& bc = c.boundary[face];
-      bc.type = parse_enum(*fb, "type", BoundaryType::NoSlip, kBoundaries);
-      if (bc.type == BoundaryType::Friction) {
-        bc.friction = fb->number("friction");
-        fb->require(bc.friction >= 0, "friction", bc.friction, "must be >= 0");
-      }
-      if (bc.type == BoundaryType::Velocity) {
-        const int ncomp = c.grid.geometry == Geometry::PlaneStrain ? 2 : 3;
-        bc.velocity_m_s = read_vec(*fb, "velocity", ncomp, {0, 0, 0}, true, dim);
-      }
-      const bool axis_face = on_axis && face == 0;
-      if (axis_face != (bc.type == BoundaryType::Axis)) {
-        fb->fail("type", axis_face ? "the face r = 0 of an axisymmetric grid is the axis: type must be \"axis\""
-                                   : "type \"axis\" is only valid for x_min of an axisymmetric grid with origin r = 0");
-      }
-      fb->finish();
-    }
-    b->finish();
-  }
-  for (int a = 0; a < dim; ++a) {
-    const bool lo = c.boundary[2 * a].type == BoundaryType::Periodic;
-    const bool hi = c.boundary[2 * a + 1].type == BoundaryType::Periodic;
-    if (lo != hi) {
-      throw InputError(fmt::format("{}: key 'boundary.{}': periodic faces come in pairs ({} and {})", path,
-                                   face_names()[2 * a], face_names()[2 * a], face_names()[2 * a + 1]));
-    }
-  }
-  if (c.grid.geometry == Geometry::Axisymmetric && c.boundary[0].type == BoundaryType::Periodic) {
-    throw InputError(fmt::format("{}: key 'boundary.x_min': the radial axis cannot be periodic", path));
-  }
-
-  // [[body]]: solid third bodies (model.md §8)
-  auto bodies = top.table_array("body");
-  for (std::size_t i = 0; i < bodies.size(); ++i) {
-    c.bodies.push_back(read_body(bodies[i], i, c));
-    for (std::size_t j = 0; j < i; ++j) {
-      if (c.bodies[j].name == c.bodies[i].name) bodies[i].fail("name", fmt::format("= \"{}\" is used twice", c.bodies[i].name));
-    }
-  }
-
-  if (auto ph = top.optional_table("physics")) {
-    c.gravity_m_s2 = read_vec(*ph, "gravity", dim, {0, 0, 0}, false);
-    ph->finish();
-  }
-
-  // [time]
-  io::TomlReader t = top.table("time");
-  c.time.duration_s = t.number("duration");
-  t.require(c.time.duration_s > 0 && std::isfinite(c.time.duration_s), "duration", c.time.duration_s,
-            "must be positive [s]");
-  c.time.dt_s = t.optional_number("dt");
-  if (c.time.dt_s) t.require(*c.time.dt_s > 0, "dt", *c.time.dt_s, "must be positive [s]");
-  c.time.cfl = t.number_or("cfl", c.time.cfl);
-  t.require(c.time.cfl > 0 && c.time.cfl <= 1, "cfl", c.time.cfl, "must lie in (0, 1]");
-  t.finish();
-
-  // [output]
-  if (auto o = top.optional_table("output")) {
-    c.output.frame_interval_s = o->number_or("frame_interval", 0.0);
-    c.output.series_interval_s = o->number_or("series_interval", 0.0);
-    const double ce = o->number_or("checkpoint_every", 0.0);
-    o->require(c.output.frame_interval_s >= 0, "frame_interval", c.output.frame_interval_s, "must be >= 0 [s]");
-    o->require(c.output.series_interval_s >= 0, "series_interval", c.output.series_interval_s, "must be >= 0 [s]");
-    o->require(ce >= 0 && ce == std::floor(ce), "checkpoint_every", ce, "must be a whole number of steps >= 0");
-    c.output.checkpoint_every = static_cast<long>(ce);
-    o->finish();
-  }
-  if (auto an = top.optional_table("analysis")) {
-    c.analysis.kind = parse_enum(*an, "kind", AnalysisKind::None, kAnalyses);
-    c.analysis.average_from_s = an->number_or("average_from", 0.0);
-    an->require(c.analysis.average_from_s >= 0 && c.analysis.average_from_s < c.time.duration_s, "average_from",
-                c.analysis.average_from_s, "must lie in [0, time.duration) [s]");
-    c.analysis.sample_interval_s = an->number_or("sample_interval", 0.0);
-    an->require(c.analysis.sample_interval_s >= 0, "sample_interval", c.analysis.sample_interval_s, "must be >= 0 [s]");
-    if (auto z = an->optional_number("sample_z")) c.analysis.sample_z_m = *z;
-    if (c.analysis.kind == AnalysisKind::Annular &&
-        (c.grid.geometry != Geometry::Axisymmetric || c.boundary[0].type != BoundaryType::Velocity)) {
-      an->fail("kind", "\"annular\" needs an axisymmetric grid whose x_min face is a velocity wall (the bob)");
-    }
-    c.analysis.body = an->string_or("body", "");
-    c.analysis.filter_window_s = an->number_or("filter_window", 0.0);
-    an->require(c.analysis.filter_window_s >= 0, "filter_window", c.analysis.filter_window_s, "must be >= 0 [s]");
-    c.analysis.front_fraction = an->number_or("front_fraction", 0.5);
-    an->require(c.analysis.front_fraction > 0 && c.analysis.front_fraction < 1, "front_fraction",
-                c.analysis.front_fraction, "must lie in (0, 1)");
-    c.analysis.f_threshold = an->number_or("f_threshold", 0.5);
-    an->require(c.analysis.f_threshold > 0 && c.analysis.f_threshold < 1, "f_threshold", c.analysis.f_threshold,
-                "must lie in (0, 1)");
-    if (an->has("snapshot_times")) {
-      const toml::array* arr = an->raw("snapshot_times")->as_array();
-      if (arr == nullptr) an->fail("snapshot_times", "must be an array of times [s]");
-      for (std::size_t i = 0; i < arr->size(); ++i) {
-        const auto v = (*arr)[i].value<double>();
-        if (!v) an->fail("snapshot_times", fmt::format("entry {} is not a number", i));
-        an->require(*v >= 0, "snapshot_times", *v, "entries must be >= 0 [s] (times after the run's end are skipped)");
-        if (i > 0) an->require(*v > c.analysis.snapshot_times_s.back(), "snapshot_times", *v, "entries must increase");
-        c.analysis.snapshot_times_s.push_back(*v);
-      }
-      if (c.grid.dim != 2) an->fail("snapshot_times", "nodal-field snapshots are written for 2D grids only");
-    }
-    const bool needs_body = c.analysis.kind == AnalysisKind::Intrusion || c.analysis.kind == AnalysisKind::Rod ||
-                            c.analysis.kind == AnalysisKind::Wheel;
-    if (needs_body) {
-      if (c.bodies.empty()) an->fail("kind", fmt::format("\"{}\" needs a [[body]]", to_string(c.analysis.kind)));
-      if (c.analysis.body.empty()) c.analysis.body = c.bodies.front().name;
-      const BodyConfig* target = nullptr;
-      for (const auto& b : c.bodies)
-        if (b.name == c.analysis.body) target = &b;
-      if (target == nullptr) an->fail("body", fmt::format("= \"{}\": no [[body]] has that name", c.analysis.body));
-      const bool axi = c.grid.geometry == Geometry::Axisymmetric;
-      if (c.analysis.kind == AnalysisKind::Intrusion && !(axi && target->motion == BodyMotionKind::Prescribed)) {
-        an->fail("kind", "\"intrusion\" needs an axisymmetric grid and a prescribed-velocity body");
-      }
-      if (c.analysis.kind == AnalysisKind::Rod && target->motion != BodyMotionKind::Free) {
-        an->fail("kind", "\"rod\" needs a free rigid body (motion = \"free\")");
-      }
-      if (c.analysis.kind == AnalysisKind::Wheel &&
-          !(c.grid.geometry == Geometry::PlaneStrain && target->motion == BodyMotionKind::Elastic)) {
-        an->fail("kind", "\"wheel\" needs a plane-strain grid and an elastic body");
-      }
-    } else if (!c.analysis.body.empty()) {
-      an->fail("body", fmt::format("is only used by the intrusion, rod and wheel analyses"));
-    }
-    an->finish();
-  }
+  // The sections in this order: each reader may use what the ones before it read (the bodies
+  // the boundary, the analysis the bodies and the duration).
+  read_scene(top, c);
+  c.grid = read_grid(top);
+  c.material = read_material(top, path);
+  read_fluid(top, c);
+  c.coupling = read_coupling(top);
+  c.transfer = read_transfer(top);
+  c.regions = read_regions(top, c.grid);
+  c.boundary = read_boundary(top, path, c.grid);
+  c.bodies = read_bodies(top, c);
+  c.gravity_m_s2 = read_physics(top, c.grid);
+  c.time = read_time(top);
+  c.output = read_output(top);
+  c.analysis = read_analysis(top, c);
   top.finish();
   return c;
 }
