@@ -436,6 +436,279 @@ struct G2PTask {
 
 namespace detail {
 
+/// G2P's sums over the nodes of one point: ∑N v_i, ∑N (v_i − v_i^old) (FLIP), ∑ v_i ∇Nᵀ, the APIC
+/// B = ∑N v_i (x_i − x_p)ᵀ, and for the mixture's fluid ∑N q_i, φ's ∑N n_i and div q = ∑ q_i·∇N.
+/// Components 0–1 as one 2-vector (one SIMD register), component 2 (if any) as a scalar.
+template <int D>
+struct G2PSums {
+  V2 vp2 = V2::Zero(), dv2 = V2::Zero(), q2 = V2::Zero(), gv2[D], B2[D];
+  double vp3 = 0.0, dv3 = 0.0, q3 = 0.0, gv3[D], B3[D];
+  double n_p = 0.0, div_q = 0.0;
+  G2PSums() {
+    for (int a = 0; a < D; ++a) {
+      gv2[a].setZero();
+      B2[a].setZero();
+      gv3[a] = 0.0;
+      B3[a] = 0.0;
+    }
+  }
+};
+
+/// G2P's first half for point p (grid_to_particles_kernel): the sums over its nodes (model.md §6
+/// step 6) from the nodal velocities, old velocities (FLIP), flux and porosity (mixture).
+template <class G, int K, bool Apic, bool ByGrad, bool Mixture, bool NoSwirl>
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void accumulate_g2p(const ShapeCache<G::dim>& cache, std::int64_t p, const double* vel, const double* vel_old,
+                           const double* flux, const double* porosity, G2PSums<G::dim>& s) {
+  constexpr int D = G::dim, NC = G::ncomp, S = support_of<D>(K);
+  constexpr bool kTheta = NC == 3 && !NoSwirl;  // the third component's sums over the nodes
+  (void)vel_old, (void)flux, (void)porosity;   // (read by the FLIP and mixture kernels only)
+  if constexpr (D == 2) {
+    // The tensor product factorised (as in P2G): per row j0 the sums over j1 of N_1 v_i,
+    // N'_1 v_i and N_1 o_1 v_i, then ∑N v = ∑ N_0 (∑N_1 v), ∇: (∑ N'_0 (∑N_1 v), ∑ N_0 (∑N'_1 v)),
+    // B = ∑N v (x_i − x_p)ᵀ = (∑ N_0 o_0 (∑N_1 v), ∑ N_0 (∑N_1 o_1 v)).
+    const Stencil<D, S>& st = cache.template stencil<S>(p);
+    const SecondAxisFactors<S> a1(st);
+    OOBLECK_UNROLL
+    for (int j0 = 0; j0 < S; ++j0) {
+      const double w0 = st.w[j0][0], dw0 = st.dw[j0][0], o0 = st.off[j0][0];
+      V2 t2 = V2::Zero(), tg2 = V2::Zero(), to2 = V2::Zero(), td2 = V2::Zero(), tq2 = V2::Zero();
+      double t3 = 0.0, tg3 = 0.0, to3 = 0.0, td3 = 0.0, tq3 = 0.0, tn = 0.0, tqy = 0.0;
+      const int row = st.index[j0][0];
+      OOBLECK_UNROLL
+      for (int j1 = 0; j1 < S; ++j1) {
+        const int i = row + st.index[j1][1];
+        const double w1 = st.w[j1][1], dw1 = st.dw[j1][1];
+        const double* vi = vel + static_cast<std::int64_t>(i) * NC;
+        const V2 vi2 = Eigen::Map<const V2>(vi);
+        t2 += a1.w[j1].cwiseProduct(vi2);
+        tg2 += a1.dw[j1].cwiseProduct(vi2);
+        if constexpr (kTheta) {
+          t3 += w1 * vi[2];
+          tg3 += dw1 * vi[2];
+        }
+        if constexpr (Apic && !ByGrad) {
+          to2 += a1.wo[j1].cwiseProduct(vi2);
+          if constexpr (kTheta) to3 += (w1 * st.off[j1][1]) * vi[2];
+        }
+        if constexpr (!Apic) {
+          const double* vo = vel_old + static_cast<std::int64_t>(i) * NC;
+          td2 += a1.w[j1].cwiseProduct(vi2 - Eigen::Map<const V2>(vo));
+          if constexpr (kTheta) td3 += w1 * (vi[2] - vo[2]);
+        }
+        if constexpr (Mixture) {
+          const double* qi = flux + static_cast<std::int64_t>(i) * NC;
+          tn += w1 * porosity[i];
+          tq2 += a1.w[j1].cwiseProduct(Eigen::Map<const V2>(qi));
+          tqy += dw1 * qi[1];
+          if constexpr (kTheta) tq3 += w1 * qi[2];
+        }
+      }
+      s.vp2 += w0 * t2;
+      s.gv2[0] += dw0 * t2;
+      s.gv2[1] += w0 * tg2;
+      if constexpr (kTheta) {
+        s.vp3 += w0 * t3;
+        s.gv3[0] += dw0 * t3;
+        s.gv3[1] += w0 * tg3;
+      }
+      if constexpr (Apic && !ByGrad) {
+        s.B2[0] += (w0 * o0) * t2;
+        s.B2[1] += w0 * to2;
+        if constexpr (kTheta) {
+          s.B3[0] += (w0 * o0) * t3;
+          s.B3[1] += w0 * to3;
+        }
+      }
+      if constexpr (!Apic) {
+        s.dv2 += w0 * td2;
+        if constexpr (kTheta) s.dv3 += w0 * td3;
+      }
+      if constexpr (Mixture) {
+        s.n_p += w0 * tn;
+        s.div_q += dw0 * tq2[0] + w0 * tqy;
+        if constexpr (G::has_hoop_terms) {
+          s.q2 += w0 * tq2;
+          if constexpr (kTheta) s.q3 += w0 * tq3;
+        }
+      }
+      (void)o0;
+    }
+  } else {
+    for_each_node<D, S>(cache.template stencil<S>(p), [&](int i, double w, const double* g, const double* off) {
+      const double* vi = vel + static_cast<std::int64_t>(i) * NC;
+      const V2 vi2 = Eigen::Map<const V2>(vi);
+      const double vi3 = NC == 3 ? vi[NC - 1] : 0.0;
+      if constexpr (Mixture) {
+        const double* qi = flux + static_cast<std::int64_t>(i) * NC;
+        s.n_p += w * porosity[i];
+        double d = qi[0] * g[0];
+        for (int a = 1; a < D; ++a) d += qi[a] * g[a];
+        s.div_q += d;
+        if constexpr (G::has_hoop_terms) {
+          s.q2 += w * Eigen::Map<const V2>(qi);
+          s.q3 += w * qi[2];
+        }
+      }
+      s.vp2 += w * vi2;
+      if constexpr (NC == 3) s.vp3 += w * vi3;
+      for (int a = 0; a < D; ++a) {
+        s.gv2[a] += vi2 * g[a];
+        if constexpr (NC == 3) s.gv3[a] += vi3 * g[a];
+      }
+      if constexpr (Apic) {
+        if constexpr (!ByGrad) {
+          const V2 wv2 = w * vi2;
+          const double wv3 = w * vi3;
+          for (int a = 0; a < D; ++a) {
+            s.B2[a] += wv2 * off[a];
+            if constexpr (NC == 3) s.B3[a] += wv3 * off[a];
+          }
+        }
+      } else {
+        const double* vo = vel_old + static_cast<std::int64_t>(i) * NC;
+        s.dv2 += w * (vi2 - Eigen::Map<const V2>(vo));
+        if constexpr (NC == 3) s.dv3 += w * (vi3 - vo[2]);
+      }
+      (void)off;
+    });
+  }
+}
+
+/// G2P's second half for point p: its new position (wrapped on periodic axes) and velocity (APIC
+/// or the FLIP/PIC blend), C (APIC), the mixture's φ and div q, and the velocity gradient L at the
+/// start-of-step position (hoop entries from ∑N v_i); returns Δt tr L (for V ← V exp(Δt tr L)) and
+/// the sum of the new x and v (for the NaN guard).
+template <class G, bool Apic, bool ByGrad, bool Mixture>
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void write_back_g2p(const G2PArgs<G>& args, std::int64_t p, G2PSums<G::dim>& s, double& vol_arg,
+                           double& kin_sum) {
+  constexpr int D = G::dim, NC = G::ncomp;
+  Body<G>& body = *args.body;
+  const Grid<G::dim>& grid = *args.grid;
+  const double alpha = args.alpha, dt_s = args.dt_s;
+  const double* const inv_D = args.cache->inv_D.data()->data();
+  Vec<D>* const xs = body.x_m.data();
+  Vec<NC>* const vs = body.v_m_s.data();
+  Mat<NC, D>* const Cs = body.C_1_s.data();
+  Mat3* const Ls = body.L_1_s.data();
+  (void)alpha, (void)inv_D, (void)Cs;  // (FLIP reads alpha; APIC inv_D and C)
+  if constexpr (D == 2) {
+    // The point's update written straight from the accumulators to its arrays, component by
+    // component (a temporary vector or matrix filled by parts and read whole stalls on store
+    // forwarding); the same values as the general path below.
+    double* const xp = xs[p].data();
+    const double x_old0 = xp[0], x_old1 = xp[1];
+    const double xn0 = grid.wrapped(0, x_old0 + dt_s * s.vp2[0]), xn1 = grid.wrapped(1, x_old1 + dt_s * s.vp2[1]);
+    xp[0] = xn0;
+    xp[1] = xn1;
+    double* const vq = vs[p].data();
+    double v_new[NC];
+    if constexpr (Apic) {
+      Eigen::Map<V2>{v_new} = s.vp2;
+      if constexpr (NC == 3) v_new[2] = s.vp3;
+    } else {
+      const V2 vb = alpha * (Eigen::Map<const V2>(vq) + s.dv2) + (1.0 - alpha) * s.vp2;
+      Eigen::Map<V2>{v_new} = vb;
+      if constexpr (NC == 3) v_new[2] = alpha * (vq[2] + s.dv3) + (1.0 - alpha) * s.vp3;
+    }
+    double v_pic[NC];
+    Eigen::Map<V2>{v_pic} = s.vp2;
+    if constexpr (NC == 3) v_pic[2] = s.vp3;
+    for (int c = 0; c < NC; ++c) vq[c] = v_new[c];
+    double g[D][NC];
+    for (int a = 0; a < D; ++a) {
+      Eigen::Map<V2>{g[a]} = s.gv2[a];
+      if constexpr (NC == 3) g[a][2] = s.gv3[a];
+    }
+    if constexpr (Apic) {
+      double* const Cq = Cs[p].data();  // column-major NC × D
+      for (int a = 0; a < D; ++a) {
+        if constexpr (ByGrad) {
+          for (int c = 0; c < NC; ++c) Cq[a * NC + c] = g[a][c];
+        } else {
+          const double sD = inv_D[p * D + a];
+          Eigen::Map<V2>(Cq + a * NC) = s.B2[a] * sD;
+          if constexpr (NC == 3) Cq[a * NC + 2] = s.B3[a] * sD;
+        }
+      }
+    }
+    const Vec<D> x_old(x_old0, x_old1);
+    if constexpr (Mixture) {
+      if constexpr (G::has_hoop_terms) {
+        const Vec<NC> qp(s.q2[0], s.q2[1], s.q3);
+        s.div_q += G::div_extra(qp, x_old);
+      }
+      body.phi[p] = 1.0 - s.n_p;
+      body.div_q_1_s[p] = s.div_q;
+    }
+    // L at the start-of-step position from the grid velocity field (hoop entries use Σ N v_i).
+    const double trL = G::write_velocity_gradient(Ls[p].data(), g[0], g[1], x_old, v_pic);
+    vol_arg = dt_s * trL;
+    double vsum = v_new[0];
+    for (int c = 1; c < NC; ++c) vsum += v_new[c];
+    kin_sum = (xn0 + xn1) + vsum;
+    return;
+  }
+  double v_pic[NC], dv[NC], q_p[NC], grad_v[D][NC], B[D][NC];  // column-major like Mat<NC, D>
+  for (int c = 0; c < 2; ++c) {
+    v_pic[c] = s.vp2[c];
+    dv[c] = s.dv2[c];
+    q_p[c] = s.q2[c];
+    for (int a = 0; a < D; ++a) {
+      grad_v[a][c] = s.gv2[a][c];
+      B[a][c] = s.B2[a][c];
+    }
+  }
+  if constexpr (NC == 3) {
+    v_pic[2] = s.vp3;
+    dv[2] = s.dv3;
+    q_p[2] = s.q3;
+    for (int a = 0; a < D; ++a) {
+      grad_v[a][2] = s.gv3[a];
+      B[a][2] = s.B3[a];
+    }
+  }
+  const Vec<D> x_old = xs[p];
+  Vec<D> x;
+  for (int a = 0; a < D; ++a) x[a] = x_old[a] + dt_s * v_pic[a];
+  grid.wrap(x);
+  xs[p] = x;
+  const Eigen::Map<const Vec<NC>> vpic(v_pic);
+  const Eigen::Map<const Mat<NC, D>> gv(&grad_v[0][0]);
+  if constexpr (Apic) {
+    vs[p] = vpic;
+    if constexpr (ByGrad) {
+      Cs[p] = gv;
+    } else {
+      Mat<NC, D> C;
+      for (int a = 0; a < D; ++a) {
+        const double sD = inv_D[p * D + a];
+        for (int c = 0; c < NC; ++c) C(c, a) = B[a][c] * sD;
+      }
+      Cs[p] = C;
+    }
+  } else {
+    Vec<NC> v;
+    for (int c = 0; c < NC; ++c) v[c] = alpha * (vs[p][c] + dv[c]) + (1.0 - alpha) * v_pic[c];
+    vs[p] = v;
+  }
+  if constexpr (Mixture) {
+    if constexpr (G::has_hoop_terms) s.div_q += G::div_extra(Eigen::Map<const Vec<NC>>(q_p), x_old);
+    body.phi[p] = 1.0 - s.n_p;
+    body.div_q_1_s[p] = s.div_q;
+  }
+  // L at the start-of-step position from the grid velocity field (hoop entries use Σ N v_i).
+  const Mat3 L = G::velocity_gradient(gv, x_old, vpic);
+  Ls[p] = L;
+  vol_arg = dt_s * L.trace();
+  kin_sum = x.sum() + vs[p].sum();
+}
+
 /// G2P for one body with the per-point branches resolved at compile time (APIC or FLIP/PIC,
 /// APIC by gradient, mixture fields). Plain scalar accumulators: the Eigen fixed-size 3-vectors of
 /// the axisymmetric mode went through the stack with partial stores and wide reloads (store
@@ -448,26 +721,16 @@ namespace detail {
 /// parallel itself).
 template <class G, int K, bool Apic, bool ByGrad, bool Mixture, bool NoSwirl = false>
 std::int64_t grid_to_particles_kernel(const G2PArgs<G>& args, std::int64_t block_begin, std::int64_t block_end) {
-  constexpr int D = G::dim, NC = G::ncomp, S = support_of<D>(K);
+  constexpr int D = G::dim;
   static_assert(!NoSwirl || G::has_hoop_terms);
-  constexpr bool kTheta = NC == 3 && !NoSwirl;  // the third component's sums over the nodes
   Body<G>& body = *args.body;
   const ShapeCache<G::dim>& cache = *args.cache;
   const GridField<G>& field = *args.field;
-  const Grid<G::dim>& grid = *args.grid;
-  const double alpha = args.alpha, dt_s = args.dt_s;
-  const Vec<G::ncomp>* const mixture_flux = args.mixture_flux;
   const double* const porosity = args.porosity;
-  (void)porosity;  // (read by the mixture kernels only)
   const std::int64_t np = body.size();
-  const double* const inv_D = cache.inv_D.data()->data();
   const double* const vel = field.velocity.data()->data();
   const double* const vel_old = field.velocity_old.data()->data();
-  const double* const flux = Mixture ? mixture_flux->data() : nullptr;
-  Vec<D>* const xs = body.x_m.data();
-  Vec<NC>* const vs = body.v_m_s.data();
-  Mat<NC, D>* const Cs = body.C_1_s.data();
-  Mat3* const Ls = body.L_1_s.data();
+  const double* const flux = Mixture ? args.mixture_flux->data() : nullptr;
   double* const Vs = body.volume_m3.data();
   std::int64_t bad = kAllFinite;
   // Points in blocks of numerics::kMathBlock: the per-point work, then the block's volume update
@@ -482,236 +745,9 @@ std::int64_t grid_to_particles_kernel(const G2PArgs<G>& args, std::int64_t block
     for (int j = nb; j < kBlock; ++j) vol_arg[j] = 0.0;
     for (int j = 0; j < nb; ++j) {
       const std::int64_t p = p0 + j;
-      // Components 0–1 as one 2-vector (one SIMD register), component 2 (if any) as a scalar.
-      V2 vp2 = V2::Zero(), dv2 = V2::Zero(), q2 = V2::Zero(), gv2[D], B2[D];
-      double vp3 = 0.0, dv3 = 0.0, q3 = 0.0, gv3[D], B3[D];
-      for (int a = 0; a < D; ++a) {
-        gv2[a].setZero();
-        B2[a].setZero();
-        gv3[a] = 0.0;
-        B3[a] = 0.0;
-      }
-      double n_p = 0.0, div_q = 0.0;
-      if constexpr (D == 2) {
-        // The tensor product factorised (as in P2G): per row j0 the sums over j1 of N_1 v_i,
-        // N'_1 v_i and N_1 o_1 v_i, then ∑N v = ∑ N_0 (∑N_1 v), ∇: (∑ N'_0 (∑N_1 v), ∑ N_0 (∑N'_1 v)),
-        // B = ∑N v (x_i − x_p)ᵀ = (∑ N_0 o_0 (∑N_1 v), ∑ N_0 (∑N_1 o_1 v)).
-        const Stencil<D, S>& st = cache.template stencil<S>(p);
-        const SecondAxisFactors<S> a1(st);
-        OOBLECK_UNROLL
-        for (int j0 = 0; j0 < S; ++j0) {
-          const double w0 = st.w[j0][0], dw0 = st.dw[j0][0], o0 = st.off[j0][0];
-          V2 t2 = V2::Zero(), tg2 = V2::Zero(), to2 = V2::Zero(), td2 = V2::Zero(), tq2 = V2::Zero();
-          double t3 = 0.0, tg3 = 0.0, to3 = 0.0, td3 = 0.0, tq3 = 0.0, tn = 0.0, tqy = 0.0;
-          const int row = st.index[j0][0];
-          OOBLECK_UNROLL
-          for (int j1 = 0; j1 < S; ++j1) {
-            const int i = row + st.index[j1][1];
-            const double w1 = st.w[j1][1], dw1 = st.dw[j1][1];
-            const double* vi = vel + static_cast<std::int64_t>(i) * NC;
-            const V2 vi2 = Eigen::Map<const V2>(vi);
-            t2 += a1.w[j1].cwiseProduct(vi2);
-            tg2 += a1.dw[j1].cwiseProduct(vi2);
-            if constexpr (kTheta) {
-              t3 += w1 * vi[2];
-              tg3 += dw1 * vi[2];
-            }
-            if constexpr (Apic && !ByGrad) {
-              to2 += a1.wo[j1].cwiseProduct(vi2);
-              if constexpr (kTheta) to3 += (w1 * st.off[j1][1]) * vi[2];
-            }
-            if constexpr (!Apic) {
-              const double* vo = vel_old + static_cast<std::int64_t>(i) * NC;
-              td2 += a1.w[j1].cwiseProduct(vi2 - Eigen::Map<const V2>(vo));
-              if constexpr (kTheta) td3 += w1 * (vi[2] - vo[2]);
-            }
-            if constexpr (Mixture) {
-              const double* qi = flux + static_cast<std::int64_t>(i) * NC;
-              tn += w1 * porosity[i];
-              tq2 += a1.w[j1].cwiseProduct(Eigen::Map<const V2>(qi));
-              tqy += dw1 * qi[1];
-              if constexpr (kTheta) tq3 += w1 * qi[2];
-            }
-          }
-          vp2 += w0 * t2;
-          gv2[0] += dw0 * t2;
-          gv2[1] += w0 * tg2;
-          if constexpr (kTheta) {
-            vp3 += w0 * t3;
-            gv3[0] += dw0 * t3;
-            gv3[1] += w0 * tg3;
-          }
-          if constexpr (Apic && !ByGrad) {
-            B2[0] += (w0 * o0) * t2;
-            B2[1] += w0 * to2;
-            if constexpr (kTheta) {
-              B3[0] += (w0 * o0) * t3;
-              B3[1] += w0 * to3;
-            }
-          }
-          if constexpr (!Apic) {
-            dv2 += w0 * td2;
-            if constexpr (kTheta) dv3 += w0 * td3;
-          }
-          if constexpr (Mixture) {
-            n_p += w0 * tn;
-            div_q += dw0 * tq2[0] + w0 * tqy;
-            if constexpr (G::has_hoop_terms) {
-              q2 += w0 * tq2;
-              if constexpr (kTheta) q3 += w0 * tq3;
-            }
-          }
-          (void)o0;
-        }
-      } else {
-        for_each_node<D, S>(cache.template stencil<S>(p), [&](int i, double w, const double* g, const double* off) {
-          const double* vi = vel + static_cast<std::int64_t>(i) * NC;
-          const V2 vi2 = Eigen::Map<const V2>(vi);
-          const double vi3 = NC == 3 ? vi[NC - 1] : 0.0;
-          if constexpr (Mixture) {
-            const double* qi = flux + static_cast<std::int64_t>(i) * NC;
-            n_p += w * porosity[i];
-            double d = qi[0] * g[0];
-            for (int a = 1; a < D; ++a) d += qi[a] * g[a];
-            div_q += d;
-            if constexpr (G::has_hoop_terms) {
-              q2 += w * Eigen::Map<const V2>(qi);
-              q3 += w * qi[2];
-            }
-          }
-          vp2 += w * vi2;
-          if constexpr (NC == 3) vp3 += w * vi3;
-          for (int a = 0; a < D; ++a) {
-            gv2[a] += vi2 * g[a];
-            if constexpr (NC == 3) gv3[a] += vi3 * g[a];
-          }
-          if constexpr (Apic) {
-            if constexpr (!ByGrad) {
-              const V2 wv2 = w * vi2;
-              const double wv3 = w * vi3;
-              for (int a = 0; a < D; ++a) {
-                B2[a] += wv2 * off[a];
-                if constexpr (NC == 3) B3[a] += wv3 * off[a];
-              }
-            }
-          } else {
-            const double* vo = vel_old + static_cast<std::int64_t>(i) * NC;
-            dv2 += w * (vi2 - Eigen::Map<const V2>(vo));
-            if constexpr (NC == 3) dv3 += w * (vi3 - vo[2]);
-          }
-          (void)off;
-        });
-      }
-      if constexpr (D == 2) {
-        // The point's update written straight from the accumulators to its arrays, component by
-        // component (a temporary vector or matrix filled by parts and read whole stalls on store
-        // forwarding); the same values as the general path below.
-        double* const xp = xs[p].data();
-        const double x_old0 = xp[0], x_old1 = xp[1];
-        const double xn0 = grid.wrapped(0, x_old0 + dt_s * vp2[0]), xn1 = grid.wrapped(1, x_old1 + dt_s * vp2[1]);
-        xp[0] = xn0;
-        xp[1] = xn1;
-        double* const vq = vs[p].data();
-        double v_new[NC];
-        if constexpr (Apic) {
-          Eigen::Map<V2>{v_new} = vp2;
-          if constexpr (NC == 3) v_new[2] = vp3;
-        } else {
-          const V2 vb = alpha * (Eigen::Map<const V2>(vq) + dv2) + (1.0 - alpha) * vp2;
-          Eigen::Map<V2>{v_new} = vb;
-          if constexpr (NC == 3) v_new[2] = alpha * (vq[2] + dv3) + (1.0 - alpha) * vp3;
-        }
-        double v_pic[NC];
-        Eigen::Map<V2>{v_pic} = vp2;
-        if constexpr (NC == 3) v_pic[2] = vp3;
-        for (int c = 0; c < NC; ++c) vq[c] = v_new[c];
-        double g[D][NC];
-        for (int a = 0; a < D; ++a) {
-          Eigen::Map<V2>{g[a]} = gv2[a];
-          if constexpr (NC == 3) g[a][2] = gv3[a];
-        }
-        if constexpr (Apic) {
-          double* const Cq = Cs[p].data();  // column-major NC × D
-          for (int a = 0; a < D; ++a) {
-            if constexpr (ByGrad) {
-              for (int c = 0; c < NC; ++c) Cq[a * NC + c] = g[a][c];
-            } else {
-              const double sD = inv_D[p * D + a];
-              Eigen::Map<V2>(Cq + a * NC) = B2[a] * sD;
-              if constexpr (NC == 3) Cq[a * NC + 2] = B3[a] * sD;
-            }
-          }
-        }
-        const Vec<D> x_old(x_old0, x_old1);
-        if constexpr (Mixture) {
-          if constexpr (G::has_hoop_terms) {
-            const Vec<NC> qp(q2[0], q2[1], q3);
-            div_q += G::div_extra(qp, x_old);
-          }
-          body.phi[p] = 1.0 - n_p;
-          body.div_q_1_s[p] = div_q;
-        }
-        // L at the start-of-step position from the grid velocity field (hoop entries use Σ N v_i).
-        const double trL = G::write_velocity_gradient(Ls[p].data(), g[0], g[1], x_old, v_pic);
-        vol_arg[j] = dt_s * trL;
-        double vsum = v_new[0];
-        for (int c = 1; c < NC; ++c) vsum += v_new[c];
-        kin_sum[j] = (xn0 + xn1) + vsum;
-        continue;
-      }
-      double v_pic[NC], dv[NC], q_p[NC], grad_v[D][NC], B[D][NC];  // column-major like Mat<NC, D>
-      for (int c = 0; c < 2; ++c) {
-        v_pic[c] = vp2[c];
-        dv[c] = dv2[c];
-        q_p[c] = q2[c];
-        for (int a = 0; a < D; ++a) {
-          grad_v[a][c] = gv2[a][c];
-          B[a][c] = B2[a][c];
-        }
-      }
-      if constexpr (NC == 3) {
-        v_pic[2] = vp3;
-        dv[2] = dv3;
-        q_p[2] = q3;
-        for (int a = 0; a < D; ++a) {
-          grad_v[a][2] = gv3[a];
-          B[a][2] = B3[a];
-        }
-      }
-      const Vec<D> x_old = xs[p];
-      Vec<D> x;
-      for (int a = 0; a < D; ++a) x[a] = x_old[a] + dt_s * v_pic[a];
-      grid.wrap(x);
-      xs[p] = x;
-      const Eigen::Map<const Vec<NC>> vpic(v_pic);
-      const Eigen::Map<const Mat<NC, D>> gv(&grad_v[0][0]);
-      if constexpr (Apic) {
-        vs[p] = vpic;
-        if constexpr (ByGrad) {
-          Cs[p] = gv;
-        } else {
-          Mat<NC, D> C;
-          for (int a = 0; a < D; ++a) {
-            const double s = inv_D[p * D + a];
-            for (int c = 0; c < NC; ++c) C(c, a) = B[a][c] * s;
-          }
-          Cs[p] = C;
-        }
-      } else {
-        Vec<NC> v;
-        for (int c = 0; c < NC; ++c) v[c] = alpha * (vs[p][c] + dv[c]) + (1.0 - alpha) * v_pic[c];
-        vs[p] = v;
-      }
-      if constexpr (Mixture) {
-        if constexpr (G::has_hoop_terms) div_q += G::div_extra(Eigen::Map<const Vec<NC>>(q_p), x_old);
-        body.phi[p] = 1.0 - n_p;
-        body.div_q_1_s[p] = div_q;
-      }
-      // L at the start-of-step position from the grid velocity field (hoop entries use Σ N v_i).
-      const Mat3 L = G::velocity_gradient(gv, x_old, vpic);
-      Ls[p] = L;
-      vol_arg[j] = dt_s * L.trace();
-      kin_sum[j] = x.sum() + vs[p].sum();
+      G2PSums<D> s;
+      accumulate_g2p<G, K, Apic, ByGrad, Mixture, NoSwirl>(cache, p, vel, vel_old, flux, porosity, s);
+      write_back_g2p<G, Apic, ByGrad, Mixture>(args, p, s, vol_arg[j], kin_sum[j]);
     }
     numerics::exp_block(vol_arg, vol_factor);
     for (int j = 0; j < nb; ++j) {
