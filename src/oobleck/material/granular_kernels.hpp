@@ -389,11 +389,152 @@ inline bool tension_accept(const F1Consts& c, double phi, double phi_m, double a
 
 }  // namespace oobleck::material::granular_kernels
 
+namespace oobleck::material::granular_kernels {
+
+/// E24 monolithic backward Euler in f (StructureUpdate::kImplicit, or kAuto when the staggered step
+/// is stiff): find f with f = f_next(return_map(f)), i.e. phi_m, a of the return map (E1, E2) and the
+/// E24 rates all at the end of the step. Z(f) = f - f_next(return_map(f)) has Z(0) <= 0 and
+/// Z(max(f_n, f_m)) >= 0 (f_next <= max(f_n, f_m)); the bracket starts at [f_n, staggered f] so that
+/// the root nearest the staggered prediction is found; Illinois iteration. `map(f)` is the return
+/// map at structure f, `f_next(r, stiff)` the linearly implicit E24 step after it (structure_step).
+/// On entry r is the return map at f_n and f_new the staggered f; on exit r, f_used (the structure
+/// of r) and f_new are those of the root, structure_iterations counts the return maps. Returns
+/// whether it converged. (GranularLaw::finish; inlined as the block of finish it was.)
+template <class Map, class FNext, class ReturnMap>
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline bool structure_implicit(const Map& map, const FNext& f_next, double fn, double fm, int max_iter, ReturnMap& r,
+                               double& f_used, double& f_new, int& structure_iterations) {
+  ReturnMap rz;
+  double dummy = 0.0;
+  auto Z = [&](double ff, ReturnMap& rr, double& fnext) {
+    rr = map(ff);
+    fnext = f_next(rr, dummy);
+    structure_iterations++;
+    return ff - fnext;
+  };
+  double a_f = fn, Za = fn - f_new;  // Z(f_n) from the staggered solve
+  ReturnMap ra = r;
+  double fa_next = f_new;
+  double b_f = f_new, fb_next = 0.0;
+  ReturnMap rb;
+  double Zb = Z(b_f, rb, fb_next);
+  if (Za != 0.0 && (Zb > 0.0) == (Za > 0.0) && Zb != 0.0) {  // no sign change: widen to the safe end
+    b_f = f_new > fn ? std::max(fn, fm) : 0.0;
+    Zb = Z(b_f, rb, fb_next);
+  }
+  bool ok = true;
+  if (Za == 0.0) {
+    rz = ra;
+    f_used = a_f;
+    f_new = fa_next;
+  } else if (Zb == 0.0 || (Zb > 0.0) == (Za > 0.0)) {
+    rz = rb;  // Zb == 0, or (only by round-off) no bracket: take the end point
+    f_used = b_f;
+    f_new = fb_next;
+    ok = std::fabs(Zb) <= 1e-12;
+  } else {
+    int side = 0;
+    ok = false;
+    for (int k = 0; k < max_iter; ++k) {
+      double fc = (Za - Zb) != 0.0 ? (a_f * Zb - b_f * Za) / (Zb - Za) : 0.5 * (a_f + b_f);
+      if (!(fc > std::min(a_f, b_f) && fc < std::max(a_f, b_f))) fc = 0.5 * (a_f + b_f);
+      double fc_next = 0.0;
+      const double Zc = Z(fc, rz, fc_next);
+      f_used = fc;
+      f_new = fc_next;
+      if (std::fabs(Zc) <= 1e-13 || std::fabs(b_f - a_f) <= 1e-14) {
+        ok = true;
+        break;
+      }
+      if ((Zc > 0.0) == (Za > 0.0)) {
+        a_f = fc;
+        Za = Zc;
+        if (side == 1) Zb *= 0.5;
+        side = 1;
+      } else {
+        b_f = fc;
+        Zb = Zc;
+        if (side == -1) Za *= 0.5;
+        side = -1;
+      }
+    }
+  }
+  r = rz;
+  return ok;
+}
+
+/// Diagnostics E18–E20 of the end state (update() only: kDiagnostics) at (tau_bar, p, gamma_dot^p)
+/// = (p, g) with E1, E2's phi_m, a of the structure the return map used: I_v, I, I_m (E19), phi_eq,
+/// beta (E18), mu_p (E20). (GranularLaw::finish.)
+template <bool kDiagnostics>
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void end_state_diagnostics(const GranularLaw& law, double phi, double eta_0, double phi_m, double a, double p,
+                                  double g, GranularRegime regime, GranularUpdate& out) {
+  const rheology::GranularParams& gp = law.granular();
+  if constexpr (!kDiagnostics) {
+    (void)gp;
+    (void)phi;
+    (void)eta_0;
+    (void)phi_m;
+    (void)a;
+    (void)p;
+    (void)g;
+    (void)regime;
+    (void)out;
+  } else if (p > 0.0 && g > 0.0) {
+    out.I_v = eta_0 * g / p;                      // E19
+    out.I = g * gp.d * std::sqrt(gp.rho_s / p);
+    out.I_m = std::sqrt(out.I * out.I + 2.0 * out.I_v);
+    out.phi_eq = phi_m / (1.0 + a * out.I_m);     // E18
+    out.beta = gp.K_3 * (phi - out.phi_eq);
+    out.mu_p = law.mu_q(out.I_m) + 2.5 * phi * out.I_v / (a * out.I_m);  // E20
+  } else if (p > 0.0 || regime == GranularRegime::kElastic) {
+    out.phi_eq = phi_m;
+    out.beta = gp.K_3 * (phi - phi_m);
+    out.mu_p = law.mu_q(0.0);
+  } else {  // p = 0: I_m -> infinity while flowing (reported as 0), phi_eq -> 0
+    out.phi_eq = g > 0.0 ? 0.0 : phi_m;
+    out.beta = g > 0.0 ? gp.K_3 * phi : gp.K_3 * (phi - phi_m);
+    out.mu_p = law.mu_q(0.0);
+  }
+}
+
+/// The final stress (E17: radial return in deviatoric space, sigma = (tau_bar/tau_tr) s_tr - p I)
+/// and f_new, written to state only when finite (else out.finite = false); out.message when the
+/// return map did not converge. (GranularLaw::finish.)
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void radial_return(const Eigen::Matrix3d& s_tr, double tau_tr, double tau, double p, double g, double f_new,
+                          GranularState& state, GranularUpdate& out) {
+  // (element by element: the Eigen expression did not inline; same operations)
+  const double scale = tau_tr > 0.0 ? tau / tau_tr : 0.0;
+  Eigen::Matrix3d sig;
+  for (int i = 0; i < 9; ++i) sig.data()[i] = scale * s_tr.data()[i];
+  for (int i = 0; i < 3; ++i) sig(i, i) -= p;
+
+  if (!finite3(sig) || !std::isfinite(f_new) || !std::isfinite(g) || !std::isfinite(p)) {
+    out.finite = false;
+    out.message = "non-finite result (state left unchanged)";
+    return;
+  }
+  if (!out.converged && out.message == nullptr) out.message = "return map did not converge within the iteration cap";
+  for (int i = 0; i < 9; ++i) state.sigma.data()[i] = sig.data()[i];
+  state.f = f_new;
+}
+
+}  // namespace oobleck::material::granular_kernels
+
 namespace oobleck::material {
 
 // The end of a point's step, after its return map: inline in both files, so that advance_batch's
 // points that its lanes cannot finish (a failed solve, the implicit structure update, the forced
-// f = 1) take the very code of advance(), inlined as in update() and advance().
+// f = 1) take the very code of advance(), inlined as in update() and advance(). The E24 structure
+// update (staggered, forced f = 1, or structure_implicit), then end_state_diagnostics and radial_return.
 template <bool kDiagnostics>
 #if defined(__GNUC__)
 [[gnu::always_inline]]
@@ -404,7 +545,6 @@ inline void GranularLaw::finish(GranularState& state, const Trial& t, ReturnMap 
   const double fn = state.f;
   out.jammed = phi >= phi_j_;
   const double p_tr = t.p_tr, tau_tr = t.tau_tr, fm = t.fm, inv_eta_B = t.inv_eta_B;
-  const Eigen::Matrix3d& s_tr = t.s;
   out.tau_trial = tau_tr;
   out.p_trial = p_tr;
   // Linearly implicit E24 step with end-of-step tau_bar, gamma_dot^p: f = (f_n + dt H' f_m)/(1 + dt (H' + S')),
@@ -413,7 +553,7 @@ inline void GranularLaw::finish(GranularState& state, const Trial& t, ReturnMap 
     return granular_kernels::structure_step(K_0_, tau_star_, xi_dot_eps_, dt, fn, fm, inv_eta_B, rr.tau, rr.g, stiff);
   };
 
-  // ---- the return map r with f_n (given), then the structure update ----
+  // ---- the return map r with f_n (given), then the E24 structure update ----
   double stiff = 0.0;
   double f_used = fn;
   double f_new = f_next(r, stiff);
@@ -422,67 +562,11 @@ inline void GranularLaw::finish(GranularState& state, const Trial& t, ReturnMap 
     f_new = 1.0;
   } else if (options_.structure_update == StructureUpdate::kImplicit ||
              (options_.structure_update == StructureUpdate::kAuto && stiff > options_.stiff_structure)) {
-    // Monolithic backward Euler in f: find f with f = f_next(return_map(f)), i.e. phi_m, a of the return
-    // map and the E24 rates all at the end of the step. Z(f) = f - f_next(return_map(f)) has Z(0) <= 0 and
-    // Z(max(f_n, f_m)) >= 0 (f_next <= max(f_n, f_m)); the bracket starts at [f_n, staggered f] so that
-    // the root nearest the staggered prediction is found; Illinois iteration.
-    ReturnMap rz;
-    double dummy = 0.0;
-    int structure_iterations = 0;  // a local, not out: out must not escape into the (out-of-line) lambda
-    auto Z = [&](double ff, ReturnMap& rr, double& fnext) {
-      rr = return_map(ff, phi, eta_0, dt, p_tr, tau_tr);
-      fnext = f_next(rr, dummy);
-      structure_iterations++;
-      return ff - fnext;
-    };
-    double a_f = fn, Za = fn - f_new;  // Z(f_n) from the staggered solve
-    ReturnMap ra = r;
-    double fa_next = f_new;
-    double b_f = f_new, fb_next = 0.0;
-    ReturnMap rb;
-    double Zb = Z(b_f, rb, fb_next);
-    if (Za != 0.0 && (Zb > 0.0) == (Za > 0.0) && Zb != 0.0) {  // no sign change: widen to the safe end
-      b_f = f_new > fn ? std::max(fn, fm) : 0.0;
-      Zb = Z(b_f, rb, fb_next);
-    }
-    bool ok = true;
-    if (Za == 0.0) {
-      rz = ra;
-      f_used = a_f;
-      f_new = fa_next;
-    } else if (Zb == 0.0 || (Zb > 0.0) == (Za > 0.0)) {
-      rz = rb;  // Zb == 0, or (only by round-off) no bracket: take the end point
-      f_used = b_f;
-      f_new = fb_next;
-      ok = std::fabs(Zb) <= 1e-12;
-    } else {
-      int side = 0;
-      ok = false;
-      for (int k = 0; k < options_.max_iter; ++k) {
-        double fc = (Za - Zb) != 0.0 ? (a_f * Zb - b_f * Za) / (Zb - Za) : 0.5 * (a_f + b_f);
-        if (!(fc > std::min(a_f, b_f) && fc < std::max(a_f, b_f))) fc = 0.5 * (a_f + b_f);
-        double fc_next = 0.0;
-        const double Zc = Z(fc, rz, fc_next);
-        f_used = fc;
-        f_new = fc_next;
-        if (std::fabs(Zc) <= 1e-13 || std::fabs(b_f - a_f) <= 1e-14) {
-          ok = true;
-          break;
-        }
-        if ((Zc > 0.0) == (Za > 0.0)) {
-          a_f = fc;
-          Za = Zc;
-          if (side == 1) Zb *= 0.5;
-          side = 1;
-        } else {
-          b_f = fc;
-          Zb = Zc;
-          if (side == -1) Za *= 0.5;
-          side = -1;
-        }
-      }
-    }
-    r = rz;
+    // backward Euler in f: the return map at the end-of-step structure
+    int structure_iterations = 0;  // a local, not out
+    auto map = [&](double ff) { return return_map(ff, phi, eta_0, dt, p_tr, tau_tr); };
+    const bool ok = granular_kernels::structure_implicit(map, f_next, fn, fm, options_.max_iter, r, f_used, f_new,
+                                                         structure_iterations);
     out.structure_iterations = structure_iterations;
     r.converged = r.converged && ok;
     if (!ok) out.message = "implicit structure update did not converge within the iteration cap";
@@ -491,31 +575,13 @@ inline void GranularLaw::finish(GranularState& state, const Trial& t, ReturnMap 
   const double a = a_0_ + (a_inf_ - a_0_) * f_used;          // E2
   out.phi_m = phi_m;
   const double tau = r.tau, p = r.p, g = r.g;
-  const GranularRegime regime = r.regime;
 
   // ---- diagnostics E18–E20 at the end state ----
-  out.regime = regime;
+  out.regime = r.regime;
   out.gamma_dot_p = g;
   out.xi_dot_1 = r.xi1;
   out.xi_dot_2 = r.xi2;
-  if constexpr (!kDiagnostics) {
-    (void)a;
-  } else if (p > 0.0 && g > 0.0) {
-    out.I_v = eta_0 * g / p;                      // E19
-    out.I = g * granular_.d * std::sqrt(granular_.rho_s / p);
-    out.I_m = std::sqrt(out.I * out.I + 2.0 * out.I_v);
-    out.phi_eq = phi_m / (1.0 + a * out.I_m);     // E18
-    out.beta = K_3_ * (phi - out.phi_eq);
-    out.mu_p = mu_q(out.I_m) + 2.5 * phi * out.I_v / (a * out.I_m);  // E20
-  } else if (p > 0.0 || regime == GranularRegime::kElastic) {
-    out.phi_eq = phi_m;
-    out.beta = K_3_ * (phi - phi_m);
-    out.mu_p = mu_q(0.0);
-  } else {  // p = 0: I_m -> infinity while flowing (reported as 0), phi_eq -> 0
-    out.phi_eq = g > 0.0 ? 0.0 : phi_m;
-    out.beta = g > 0.0 ? K_3_ * phi : K_3_ * (phi - phi_m);
-    out.mu_p = mu_q(0.0);
-  }
+  granular_kernels::end_state_diagnostics<kDiagnostics>(*this, phi, eta_0, phi_m, a, p, g, r.regime, out);
   out.tau_bar = tau;
   out.p = p;
   out.iterations = r.iterations;
@@ -523,20 +589,7 @@ inline void GranularLaw::finish(GranularState& state, const Trial& t, ReturnMap 
   out.converged = r.converged;
 
   // ---- final stress: radial return in deviatoric space ----
-  // (element by element: the Eigen expression did not inline; same operations)
-  const double scale = tau_tr > 0.0 ? tau / tau_tr : 0.0;
-  Eigen::Matrix3d sig;
-  for (int i = 0; i < 9; ++i) sig.data()[i] = scale * s_tr.data()[i];
-  for (int i = 0; i < 3; ++i) sig(i, i) -= p;
-
-  if (!granular_kernels::finite3(sig) || !std::isfinite(f_new) || !std::isfinite(g) || !std::isfinite(p)) {
-    out.finite = false;
-    out.message = "non-finite result (state left unchanged)";
-    return;
-  }
-  if (!out.converged && out.message == nullptr) out.message = "return map did not converge within the iteration cap";
-  for (int i = 0; i < 9; ++i) state.sigma.data()[i] = sig.data()[i];
-  state.f = f_new;
+  granular_kernels::radial_return(t.s, tau_tr, tau, p, g, f_new, state, out);
 }
 
 }  // namespace oobleck::material
