@@ -94,6 +94,196 @@ struct SecondAxisFactors {
   }
 };
 
+/// A point's terms of P2G (particles_to_grid_point_inlined): m_p, V_p, V_p p (the fluid's pressure
+/// split), V_p σ (or V_p τ) and C by columns, v, the point force f_pt (external load, and the
+/// axisymmetric hoop and inertial terms) and the pressure's hoop term. Components 0–1 as one
+/// 2-vector (one SIMD register), component 2 (if any) as a scalar.
+template <int D>
+struct P2GPointTerms {
+  double mp = 0.0, Vp = 0.0, Vpres = 0.0;
+  V2 Vsig2[D], Cp2[D], v2, fpt2;
+  double Vsig3[D], Cp3[D], v3 = 0.0, fpt3 = 0.0, fppt[3] = {0.0, 0.0, 0.0};
+};
+
+template <class G, bool Split>
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline P2GPointTerms<G::dim> p2g_point_terms(const Body<G>& body, std::int64_t p) {
+  constexpr int D = G::dim, NC = G::ncomp;
+  P2GPointTerms<D> t;
+  const double mp = body.mass_kg[p], Vp = body.volume_m3[p];
+  const Vec<NC> vp = body.v_m_s[p];
+  Mat3 sig = body.stress_Pa[p];
+  double Vpres = 0.0;
+  if constexpr (Split) {
+    const double pres = -sig.trace() * (1.0 / 3.0);  // × 1/3, not ÷ 3: no division latency per point
+    sig.diagonal().array() += pres;  // τ = σ + p 1
+    Vpres = Vp * pres;
+  }
+  double Vsig[D][NC], Cp[D][NC], v[NC], fpt[NC], fppt[NC];
+  for (int a = 0; a < D; ++a)
+    for (int c = 0; c < NC; ++c) {
+      Vsig[a][c] = Vp * sig(c, a);
+      Cp[a][c] = body.C_1_s[p](c, a);
+    }
+  // Axisymmetric: hoop and inertial terms, applied with weight N_ip (zero-cost otherwise).
+  Vec<NC> f_point = body.f_ext_N[p];  // external point load
+  if constexpr (G::has_hoop_terms) {
+    const Vec<D>& xp = body.x_m[p];
+    f_point += G::hoop_force(sig, xp, Vp) + mp * G::inertial_acceleration(xp, vp);
+    if constexpr (Split) {
+      const Vec<NC> h = G::hoop_force(-(Vpres / Vp) * Mat3::Identity(), xp, Vp);
+      for (int c = 0; c < NC; ++c) fppt[c] = h[c];
+    }
+  }
+  for (int c = 0; c < NC; ++c) {
+    v[c] = vp[c];
+    fpt[c] = f_point[c];
+  }
+  // Components 0–1 as one 2-vector (one SIMD register), component 2 (if any) as a scalar.
+  V2 Vsig2[D], Cp2[D];
+  double Vsig3[D], Cp3[D];
+  for (int a = 0; a < D; ++a) {
+    Vsig2[a] = V2(Vsig[a][0], Vsig[a][1]);
+    Cp2[a] = V2(Cp[a][0], Cp[a][1]);
+    Vsig3[a] = NC == 3 ? Vsig[a][NC - 1] : 0.0;
+    Cp3[a] = NC == 3 ? Cp[a][NC - 1] : 0.0;
+  }
+  const V2 v2(v[0], v[1]), fpt2(fpt[0], fpt[1]);
+  const double v3 = v[NC - 1], fpt3 = fpt[NC - 1];
+  t.mp = mp, t.Vp = Vp, t.Vpres = Vpres;
+  for (int a = 0; a < D; ++a) {
+    t.Vsig2[a] = Vsig2[a], t.Cp2[a] = Cp2[a];
+    t.Vsig3[a] = Vsig3[a], t.Cp3[a] = Cp3[a];
+  }
+  t.v2 = v2, t.fpt2 = fpt2, t.v3 = v3, t.fpt3 = fpt3;
+  if constexpr (G::has_hoop_terms && Split)
+    for (int c = 0; c < NC; ++c) t.fppt[c] = fppt[c];
+  return t;
+}
+
+/// P2G's scatter of point p on a 2D grid, the tensor product factorised (docs/mpm.md, "Data
+/// layout"): with N = N_0 N_1, ∇N = (N'_0 N_1, N_0 N'_1) and x_i − x_p = (o_0, o_1), every nodal
+/// term is N_1 (a per-row value) + N'_1 or N_1 o_1 (another per-row value); the per-row values are
+/// formed once for each of the S rows j0, so a node costs a few multiply-adds.
+template <class G, int K, bool Apic, bool Split, bool NoSwirl>
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void p2g_scatter_point_2d(const P2GPointTerms<G::dim>& t, const ShapeCache<G::dim>& cache, std::int64_t p, double* m,
+                        double* mv, double* f, double* fp, double* vol) {
+  constexpr int D = G::dim, NC = G::ncomp, S = support_of<D>(K);
+  constexpr bool kTheta = NC == 3 && !NoSwirl;  // the third component's nodal terms
+  const double mp = t.mp, Vp = t.Vp, Vpres = t.Vpres;
+  const V2 *Vsig2 = t.Vsig2, *Cp2 = t.Cp2;
+  const double *Vsig3 = t.Vsig3, *Cp3 = t.Cp3, *fppt = t.fppt;
+  const V2 v2 = t.v2, fpt2 = t.fpt2;
+  const double v3 = t.v3, fpt3 = t.fpt3;
+  (void)Vp, (void)Vpres, (void)Cp2, (void)Cp3, (void)fppt, (void)v3, (void)fpt3;
+  const Stencil<D, S>& st = cache.template stencil<S>(p);
+  const SecondAxisFactors<S> a1(st);
+  OOBLECK_UNROLL
+  for (int j0 = 0; j0 < S; ++j0) {
+    const double w0 = st.w[j0][0], dw0 = st.dw[j0][0], o0 = st.off[j0][0];
+    const double P = mp * w0;  // m_p N_0
+    // momentum: N m_p (v + C (x_i − x_p)) = N_1 P (v + C_0 o_0) + N_1 o_1 P C_1
+    V2 U2 = P * v2, Vc2 = V2::Zero();
+    double U3 = P * v3, Vc3 = 0.0;
+    if constexpr (Apic) {
+      U2 = P * (v2 + Cp2[0] * o0);
+      Vc2 = P * Cp2[1];
+      U3 = P * (v3 + Cp3[0] * o0);
+      Vc3 = P * Cp3[1];
+    }
+    // force: −V σ ∇N + N f_pt = N_1 (N_0 f_pt − N'_0 V σ_0) − N'_1 N_0 V σ_1
+    const V2 E2 = w0 * fpt2 - dw0 * Vsig2[0], nB2 = -w0 * Vsig2[1];
+    const double E3 = w0 * fpt3 - dw0 * Vsig3[0], nB3 = -w0 * Vsig3[1];
+    const V2 PV2(Vpres * dw0, Vpres * w0);
+    const int row = st.index[j0][0];
+    OOBLECK_UNROLL
+    for (int j1 = 0; j1 < S; ++j1) {
+      const int i = row + st.index[j1][1];
+      const double w1 = st.w[j1][1], dw1 = st.dw[j1][1];
+      double* mvi = mv + static_cast<std::int64_t>(i) * NC;
+      double* fi = f + static_cast<std::int64_t>(i) * NC;
+      m[i] += P * w1;
+      Eigen::Map<V2> mvi2(mvi), fi2(fi);
+      if constexpr (Apic) mvi2 += a1.w[j1].cwiseProduct(U2) + a1.wo[j1].cwiseProduct(Vc2);
+      else mvi2 += a1.w[j1].cwiseProduct(U2);
+      fi2 += a1.w[j1].cwiseProduct(E2) + a1.dw[j1].cwiseProduct(nB2);
+      if constexpr (kTheta) {
+        if constexpr (Apic) mvi[2] += w1 * U3 + (w1 * st.off[j1][1]) * Vc3;
+        else mvi[2] += w1 * U3;
+        fi[2] += w1 * E3 + dw1 * nB3;
+      }
+      if constexpr (Split) {
+        double* fpi = fp + static_cast<std::int64_t>(i) * NC;
+        Eigen::Map<V2>(fpi) += PV2.cwiseProduct(a1.w_dw[j1]);  // V_p p (N'_0 N_1, N_0 N'_1)
+        if constexpr (G::has_hoop_terms)
+          fpi[0] += w1 * (w0 * fppt[0]);  // (its z and θ entries are zeros: left out)
+        vol[i] += (w0 * Vp) * w1;
+      }
+    }
+  }
+}
+
+/// P2G's scatter of point p node by node (3D).
+template <class G, int K, bool Apic, bool Split, bool NoSwirl>
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void p2g_scatter_point_general(const P2GPointTerms<G::dim>& t, const ShapeCache<G::dim>& cache, std::int64_t p, double* m,
+                        double* mv, double* f, double* fp, double* vol) {
+  constexpr int D = G::dim, NC = G::ncomp, S = support_of<D>(K);
+  const double mp = t.mp, Vp = t.Vp, Vpres = t.Vpres;
+  const V2 *Vsig2 = t.Vsig2, *Cp2 = t.Cp2;
+  const double *Vsig3 = t.Vsig3, *Cp3 = t.Cp3, *fppt = t.fppt;
+  const V2 v2 = t.v2, fpt2 = t.fpt2;
+  const double v3 = t.v3, fpt3 = t.fpt3;
+  (void)Vp, (void)Vpres, (void)Cp2, (void)Cp3, (void)fppt, (void)v3, (void)fpt3;
+  for_each_node<D, S>(cache.template stencil<S>(p), [&](int i, double w, const double* g, const double* off) {
+    const double wm = w * mp;
+    double* mvi = mv + static_cast<std::int64_t>(i) * NC;
+    double* fi = f + static_cast<std::int64_t>(i) * NC;
+    m[i] += wm;
+    Eigen::Map<V2> mvi2(mvi), fi2(fi);
+    if constexpr (Apic) {
+      V2 cx = Cp2[0] * off[0];
+      for (int a = 1; a < D; ++a) cx += Cp2[a] * off[a];
+      mvi2 += wm * (v2 + cx);
+      if constexpr (NC == 3) {
+        double cx3 = Cp3[0] * off[0];
+        for (int a = 1; a < D; ++a) cx3 += Cp3[a] * off[a];
+        mvi[2] += wm * (v3 + cx3);
+      }
+    } else {
+      (void)off;
+      mvi2 += wm * v2;
+      if constexpr (NC == 3) mvi[2] += wm * v3;
+    }
+    {
+      V2 s2 = Vsig2[0] * g[0];
+      for (int a = 1; a < D; ++a) s2 += Vsig2[a] * g[a];
+      fi2 -= s2;
+      fi2 += w * fpt2;
+      if constexpr (NC == 3) {
+        double s3 = Vsig3[0] * g[0];
+        for (int a = 1; a < D; ++a) s3 += Vsig3[a] * g[a];
+        fi[2] -= s3;
+        fi[2] += w * fpt3;
+      }
+    }
+    if constexpr (Split) {
+      double* fpi = fp + static_cast<std::int64_t>(i) * NC;
+      for (int a = 0; a < D; ++a) fpi[a] += Vpres * g[a];
+      if constexpr (G::has_hoop_terms)
+        for (int c = 0; c < NC; ++c) fpi[c] += w * fppt[c];
+      vol[i] += w * Vp;
+    }
+  });
+}
+
 /// Scatter of point p (P2G, see p2g_scatter_range), with the APIC and
 /// split-pressure branches resolved at compile time and scalar per-point temporaries (no
 /// stack round trips of Eigen 3-vectors in the node loop). Arithmetic order per component is that
@@ -112,143 +302,10 @@ template <class G, int K, bool Apic, bool Split, bool NoSwirl = false>
 #endif
 inline void particles_to_grid_point_inlined(const Body<G>& body, const ShapeCache<G::dim>& cache, std::int64_t p,
                                             double* m, double* mv, double* f, double* fp, double* vol) {
-  constexpr int D = G::dim, NC = G::ncomp, S = support_of<D>(K);
   static_assert(!NoSwirl || G::has_hoop_terms);
-  constexpr bool kTheta = NC == 3 && !NoSwirl;  // the third component's nodal terms
-  {
-    const double mp = body.mass_kg[p], Vp = body.volume_m3[p];
-    const Vec<NC> vp = body.v_m_s[p];
-    Mat3 sig = body.stress_Pa[p];
-    double Vpres = 0.0;
-    if constexpr (Split) {
-      const double pres = -sig.trace() * (1.0 / 3.0);  // × 1/3, not ÷ 3: no division latency per point
-      sig.diagonal().array() += pres;  // τ = σ + p 1
-      Vpres = Vp * pres;
-    }
-    double Vsig[D][NC], Cp[D][NC], v[NC], fpt[NC], fppt[NC];
-    for (int a = 0; a < D; ++a)
-      for (int c = 0; c < NC; ++c) {
-        Vsig[a][c] = Vp * sig(c, a);
-        Cp[a][c] = body.C_1_s[p](c, a);
-      }
-    // Axisymmetric: hoop and inertial terms, applied with weight N_ip (zero-cost otherwise).
-    Vec<NC> f_point = body.f_ext_N[p];  // external point load
-    if constexpr (G::has_hoop_terms) {
-      const Vec<D>& xp = body.x_m[p];
-      f_point += G::hoop_force(sig, xp, Vp) + mp * G::inertial_acceleration(xp, vp);
-      if constexpr (Split) {
-        const Vec<NC> h = G::hoop_force(-(Vpres / Vp) * Mat3::Identity(), xp, Vp);
-        for (int c = 0; c < NC; ++c) fppt[c] = h[c];
-      }
-    }
-    for (int c = 0; c < NC; ++c) {
-      v[c] = vp[c];
-      fpt[c] = f_point[c];
-    }
-    // Components 0–1 as one 2-vector (one SIMD register), component 2 (if any) as a scalar.
-    V2 Vsig2[D], Cp2[D];
-    double Vsig3[D], Cp3[D];
-    for (int a = 0; a < D; ++a) {
-      Vsig2[a] = V2(Vsig[a][0], Vsig[a][1]);
-      Cp2[a] = V2(Cp[a][0], Cp[a][1]);
-      Vsig3[a] = NC == 3 ? Vsig[a][NC - 1] : 0.0;
-      Cp3[a] = NC == 3 ? Cp[a][NC - 1] : 0.0;
-    }
-    const V2 v2(v[0], v[1]), fpt2(fpt[0], fpt[1]);
-    const double v3 = v[NC - 1], fpt3 = fpt[NC - 1];
-    if constexpr (D == 2) {
-      // The tensor product factorised (docs/mpm.md, "Factorised transfers"): with N = N_0 N_1,
-      // ∇N = (N'_0 N_1, N_0 N'_1) and x_i − x_p = (o_0, o_1), every nodal term is
-      // N_1 (a per-row value) + N'_1 or N_1 o_1 (another per-row value); the per-row values are
-      // formed once for each of the S rows j0, so a node costs a few multiply-adds.
-      const Stencil<D, S>& st = cache.template stencil<S>(p);
-      const SecondAxisFactors<S> a1(st);
-      OOBLECK_UNROLL
-      for (int j0 = 0; j0 < S; ++j0) {
-        const double w0 = st.w[j0][0], dw0 = st.dw[j0][0], o0 = st.off[j0][0];
-        const double P = mp * w0;  // m_p N_0
-        // momentum: N m_p (v + C (x_i − x_p)) = N_1 P (v + C_0 o_0) + N_1 o_1 P C_1
-        V2 U2 = P * v2, Vc2 = V2::Zero();
-        double U3 = P * v3, Vc3 = 0.0;
-        if constexpr (Apic) {
-          U2 = P * (v2 + Cp2[0] * o0);
-          Vc2 = P * Cp2[1];
-          U3 = P * (v3 + Cp3[0] * o0);
-          Vc3 = P * Cp3[1];
-        }
-        // force: −V σ ∇N + N f_pt = N_1 (N_0 f_pt − N'_0 V σ_0) − N'_1 N_0 V σ_1
-        const V2 E2 = w0 * fpt2 - dw0 * Vsig2[0], nB2 = -w0 * Vsig2[1];
-        const double E3 = w0 * fpt3 - dw0 * Vsig3[0], nB3 = -w0 * Vsig3[1];
-        const V2 PV2(Vpres * dw0, Vpres * w0);
-        const int row = st.index[j0][0];
-        OOBLECK_UNROLL
-        for (int j1 = 0; j1 < S; ++j1) {
-          const int i = row + st.index[j1][1];
-          const double w1 = st.w[j1][1], dw1 = st.dw[j1][1];
-          double* mvi = mv + static_cast<std::int64_t>(i) * NC;
-          double* fi = f + static_cast<std::int64_t>(i) * NC;
-          m[i] += P * w1;
-          Eigen::Map<V2> mvi2(mvi), fi2(fi);
-          if constexpr (Apic) mvi2 += a1.w[j1].cwiseProduct(U2) + a1.wo[j1].cwiseProduct(Vc2);
-          else mvi2 += a1.w[j1].cwiseProduct(U2);
-          fi2 += a1.w[j1].cwiseProduct(E2) + a1.dw[j1].cwiseProduct(nB2);
-          if constexpr (kTheta) {
-            if constexpr (Apic) mvi[2] += w1 * U3 + (w1 * st.off[j1][1]) * Vc3;
-            else mvi[2] += w1 * U3;
-            fi[2] += w1 * E3 + dw1 * nB3;
-          }
-          if constexpr (Split) {
-            double* fpi = fp + static_cast<std::int64_t>(i) * NC;
-            Eigen::Map<V2>(fpi) += PV2.cwiseProduct(a1.w_dw[j1]);  // V_p p (N'_0 N_1, N_0 N'_1)
-            if constexpr (G::has_hoop_terms)
-              fpi[0] += w1 * (w0 * fppt[0]);  // (its z and θ entries are zeros: left out)
-            vol[i] += (w0 * Vp) * w1;
-          }
-        }
-      }
-      return;
-    }
-    for_each_node<D, S>(cache.template stencil<S>(p), [&](int i, double w, const double* g, const double* off) {
-      const double wm = w * mp;
-      double* mvi = mv + static_cast<std::int64_t>(i) * NC;
-      double* fi = f + static_cast<std::int64_t>(i) * NC;
-      m[i] += wm;
-      Eigen::Map<V2> mvi2(mvi), fi2(fi);
-      if constexpr (Apic) {
-        V2 cx = Cp2[0] * off[0];
-        for (int a = 1; a < D; ++a) cx += Cp2[a] * off[a];
-        mvi2 += wm * (v2 + cx);
-        if constexpr (NC == 3) {
-          double cx3 = Cp3[0] * off[0];
-          for (int a = 1; a < D; ++a) cx3 += Cp3[a] * off[a];
-          mvi[2] += wm * (v3 + cx3);
-        }
-      } else {
-        (void)off;
-        mvi2 += wm * v2;
-        if constexpr (NC == 3) mvi[2] += wm * v3;
-      }
-      {
-        V2 s2 = Vsig2[0] * g[0];
-        for (int a = 1; a < D; ++a) s2 += Vsig2[a] * g[a];
-        fi2 -= s2;
-        fi2 += w * fpt2;
-        if constexpr (NC == 3) {
-          double s3 = Vsig3[0] * g[0];
-          for (int a = 1; a < D; ++a) s3 += Vsig3[a] * g[a];
-          fi[2] -= s3;
-          fi[2] += w * fpt3;
-        }
-      }
-      if constexpr (Split) {
-        double* fpi = fp + static_cast<std::int64_t>(i) * NC;
-        for (int a = 0; a < D; ++a) fpi[a] += Vpres * g[a];
-        if constexpr (G::has_hoop_terms)
-          for (int c = 0; c < NC; ++c) fpi[c] += w * fppt[c];
-        vol[i] += w * Vp;
-      }
-    });
-  }
+  const P2GPointTerms<G::dim> t = p2g_point_terms<G, Split>(body, p);
+  if constexpr (G::dim == 2) p2g_scatter_point_2d<G, K, Apic, Split, NoSwirl>(t, cache, p, m, mv, f, fp, vol);
+  else p2g_scatter_point_general<G, K, Apic, Split, NoSwirl>(t, cache, p, m, mv, f, fp, vol);
 }
 
 /// particles_to_grid_point_inlined behind a call that GCC may or may not inline (the
@@ -577,15 +634,14 @@ inline void accumulate_g2p(const ShapeCache<G::dim>& cache, std::int64_t p, cons
   }
 }
 
-/// G2P's second half for point p: its new position (wrapped on periodic axes) and velocity (APIC
-/// or the FLIP/PIC blend), C (APIC), the mixture's φ and div q, and the velocity gradient L at the
-/// start-of-step position (hoop entries from ∑N v_i); returns Δt tr L (for V ← V exp(Δt tr L)) and
-/// the sum of the new x and v (for the NaN guard).
+/// write_back_g2p for a 2D grid: the update written straight from the accumulators to the
+/// point's arrays, component by component (a temporary vector or matrix filled by parts and read
+/// whole stalls on store forwarding); the same values as write_back_g2p_general.
 template <class G, bool Apic, bool ByGrad, bool Mixture>
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void write_back_g2p(const G2PArgs<G>& args, std::int64_t p, G2PSums<G::dim>& s, double& vol_arg,
+inline void write_back_g2p_2d(const G2PArgs<G>& args, std::int64_t p, G2PSums<G::dim>& s, double& vol_arg,
                            double& kin_sum) {
   constexpr int D = G::dim, NC = G::ncomp;
   Body<G>& body = *args.body;
@@ -597,63 +653,79 @@ inline void write_back_g2p(const G2PArgs<G>& args, std::int64_t p, G2PSums<G::di
   Mat<NC, D>* const Cs = body.C_1_s.data();
   Mat3* const Ls = body.L_1_s.data();
   (void)alpha, (void)inv_D, (void)Cs;  // (FLIP reads alpha; APIC inv_D and C)
-  if constexpr (D == 2) {
-    // The point's update written straight from the accumulators to its arrays, component by
-    // component (a temporary vector or matrix filled by parts and read whole stalls on store
-    // forwarding); the same values as the general path below.
-    double* const xp = xs[p].data();
-    const double x_old0 = xp[0], x_old1 = xp[1];
-    const double xn0 = grid.wrapped(0, x_old0 + dt_s * s.vp2[0]), xn1 = grid.wrapped(1, x_old1 + dt_s * s.vp2[1]);
-    xp[0] = xn0;
-    xp[1] = xn1;
-    double* const vq = vs[p].data();
-    double v_new[NC];
-    if constexpr (Apic) {
-      Eigen::Map<V2>{v_new} = s.vp2;
-      if constexpr (NC == 3) v_new[2] = s.vp3;
-    } else {
-      const V2 vb = alpha * (Eigen::Map<const V2>(vq) + s.dv2) + (1.0 - alpha) * s.vp2;
-      Eigen::Map<V2>{v_new} = vb;
-      if constexpr (NC == 3) v_new[2] = alpha * (vq[2] + s.dv3) + (1.0 - alpha) * s.vp3;
-    }
-    double v_pic[NC];
-    Eigen::Map<V2>{v_pic} = s.vp2;
-    if constexpr (NC == 3) v_pic[2] = s.vp3;
-    for (int c = 0; c < NC; ++c) vq[c] = v_new[c];
-    double g[D][NC];
-    for (int a = 0; a < D; ++a) {
-      Eigen::Map<V2>{g[a]} = s.gv2[a];
-      if constexpr (NC == 3) g[a][2] = s.gv3[a];
-    }
-    if constexpr (Apic) {
-      double* const Cq = Cs[p].data();  // column-major NC × D
-      for (int a = 0; a < D; ++a) {
-        if constexpr (ByGrad) {
-          for (int c = 0; c < NC; ++c) Cq[a * NC + c] = g[a][c];
-        } else {
-          const double sD = inv_D[p * D + a];
-          Eigen::Map<V2>(Cq + a * NC) = s.B2[a] * sD;
-          if constexpr (NC == 3) Cq[a * NC + 2] = s.B3[a] * sD;
-        }
-      }
-    }
-    const Vec<D> x_old(x_old0, x_old1);
-    if constexpr (Mixture) {
-      if constexpr (G::has_hoop_terms) {
-        const Vec<NC> qp(s.q2[0], s.q2[1], s.q3);
-        s.div_q += G::div_extra(qp, x_old);
-      }
-      body.phi[p] = 1.0 - s.n_p;
-      body.div_q_1_s[p] = s.div_q;
-    }
-    // L at the start-of-step position from the grid velocity field (hoop entries use Σ N v_i).
-    const double trL = G::write_velocity_gradient(Ls[p].data(), g[0], g[1], x_old, v_pic);
-    vol_arg = dt_s * trL;
-    double vsum = v_new[0];
-    for (int c = 1; c < NC; ++c) vsum += v_new[c];
-    kin_sum = (xn0 + xn1) + vsum;
-    return;
+  // The point's update written straight from the accumulators to its arrays, component by
+  // component (a temporary vector or matrix filled by parts and read whole stalls on store
+  // forwarding); the same values as the general path below.
+  double* const xp = xs[p].data();
+  const double x_old0 = xp[0], x_old1 = xp[1];
+  const double xn0 = grid.wrapped(0, x_old0 + dt_s * s.vp2[0]), xn1 = grid.wrapped(1, x_old1 + dt_s * s.vp2[1]);
+  xp[0] = xn0;
+  xp[1] = xn1;
+  double* const vq = vs[p].data();
+  double v_new[NC];
+  if constexpr (Apic) {
+    Eigen::Map<V2>{v_new} = s.vp2;
+    if constexpr (NC == 3) v_new[2] = s.vp3;
+  } else {
+    const V2 vb = alpha * (Eigen::Map<const V2>(vq) + s.dv2) + (1.0 - alpha) * s.vp2;
+    Eigen::Map<V2>{v_new} = vb;
+    if constexpr (NC == 3) v_new[2] = alpha * (vq[2] + s.dv3) + (1.0 - alpha) * s.vp3;
   }
+  double v_pic[NC];
+  Eigen::Map<V2>{v_pic} = s.vp2;
+  if constexpr (NC == 3) v_pic[2] = s.vp3;
+  for (int c = 0; c < NC; ++c) vq[c] = v_new[c];
+  double g[D][NC];
+  for (int a = 0; a < D; ++a) {
+    Eigen::Map<V2>{g[a]} = s.gv2[a];
+    if constexpr (NC == 3) g[a][2] = s.gv3[a];
+  }
+  if constexpr (Apic) {
+    double* const Cq = Cs[p].data();  // column-major NC × D
+    for (int a = 0; a < D; ++a) {
+      if constexpr (ByGrad) {
+        for (int c = 0; c < NC; ++c) Cq[a * NC + c] = g[a][c];
+      } else {
+        const double sD = inv_D[p * D + a];
+        Eigen::Map<V2>(Cq + a * NC) = s.B2[a] * sD;
+        if constexpr (NC == 3) Cq[a * NC + 2] = s.B3[a] * sD;
+      }
+    }
+  }
+  const Vec<D> x_old(x_old0, x_old1);
+  if constexpr (Mixture) {
+    if constexpr (G::has_hoop_terms) {
+      const Vec<NC> qp(s.q2[0], s.q2[1], s.q3);
+      s.div_q += G::div_extra(qp, x_old);
+    }
+    body.phi[p] = 1.0 - s.n_p;
+    body.div_q_1_s[p] = s.div_q;
+  }
+  // L at the start-of-step position from the grid velocity field (hoop entries use Σ N v_i).
+  const double trL = G::write_velocity_gradient(Ls[p].data(), g[0], g[1], x_old, v_pic);
+  vol_arg = dt_s * trL;
+  double vsum = v_new[0];
+  for (int c = 1; c < NC; ++c) vsum += v_new[c];
+  kin_sum = (xn0 + xn1) + vsum;
+}
+
+/// write_back_g2p for any grid (3D).
+template <class G, bool Apic, bool ByGrad, bool Mixture>
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void write_back_g2p_general(const G2PArgs<G>& args, std::int64_t p, G2PSums<G::dim>& s, double& vol_arg,
+                           double& kin_sum) {
+  constexpr int D = G::dim, NC = G::ncomp;
+  Body<G>& body = *args.body;
+  const Grid<G::dim>& grid = *args.grid;
+  const double alpha = args.alpha, dt_s = args.dt_s;
+  const double* const inv_D = args.cache->inv_D.data()->data();
+  Vec<D>* const xs = body.x_m.data();
+  Vec<NC>* const vs = body.v_m_s.data();
+  Mat<NC, D>* const Cs = body.C_1_s.data();
+  Mat3* const Ls = body.L_1_s.data();
+  (void)alpha, (void)inv_D, (void)Cs;  // (FLIP reads alpha; APIC inv_D and C)
   double v_pic[NC], dv[NC], q_p[NC], grad_v[D][NC], B[D][NC];  // column-major like Mat<NC, D>
   for (int c = 0; c < 2; ++c) {
     v_pic[c] = s.vp2[c];
@@ -707,6 +779,20 @@ inline void write_back_g2p(const G2PArgs<G>& args, std::int64_t p, G2PSums<G::di
   Ls[p] = L;
   vol_arg = dt_s * L.trace();
   kin_sum = x.sum() + vs[p].sum();
+}
+
+/// G2P's second half for point p: its new position (wrapped on periodic axes) and velocity (APIC
+/// or the FLIP/PIC blend), C (APIC), the mixture's φ and div q, and the velocity gradient L at the
+/// start-of-step position (hoop entries from ∑N v_i); returns Δt tr L (for V ← V exp(Δt tr L)) and
+/// the sum of the new x and v (for the NaN guard).
+template <class G, bool Apic, bool ByGrad, bool Mixture>
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void write_back_g2p(const G2PArgs<G>& args, std::int64_t p, G2PSums<G::dim>& s, double& vol_arg,
+                           double& kin_sum) {
+  if constexpr (G::dim == 2) write_back_g2p_2d<G, Apic, ByGrad, Mixture>(args, p, s, vol_arg, kin_sum);
+  else write_back_g2p_general<G, Apic, ByGrad, Mixture>(args, p, s, vol_arg, kin_sum);
 }
 
 /// G2P for one body with the per-point branches resolved at compile time (APIC or FLIP/PIC,
