@@ -3,6 +3,7 @@
 // every point once, be independent of each other (any order gives the whole-body update bit for
 // bit), and the NaN guard must report the lowest bad index over all chunks.
 #include <gtest/gtest.h>
+#include <fmt/format.h>
 
 #include <cmath>
 #include <cstdint>
@@ -142,4 +143,33 @@ TEST(BodyLaws, TheGuardReportsTheLowestBadPointOverAllChunks) {
       EXPECT_NE(std::string(e.what()).find("point 700 "), std::string::npos) << e.what();
     }
   }
+}
+
+// The registry of persistent fields (mpm/fields.hpp): a body and its law declare their arrays
+// once, with the checkpoint datasets and frame names that the run output uses.
+TEST(PersistentFields, BodyAndLawsDeclareTheirArrays) {
+  auto names = [](Body<PlaneStrain>& b) {
+    FieldList list;
+    list.group("body0");
+    b.declare_fields(list);
+    b.law->declare_fields(b, list);
+    std::string ck, frame;
+    for (const auto& f : list.fields())
+      if (f.in_checkpoint) ck += f.dataset() + fmt::format(":{} ", f.width);
+    for (const auto* f : list.frame_fields()) frame += f->shown_as() + " ";
+    return ck + "| " + frame;
+  };
+  Body<PlaneStrain> grains = random_body(10, 1, 2500.0);
+  grains.set_law(std::make_unique<GranularBodyLaw<PlaneStrain>>(rheology::load_preset("hermes2016")));
+  EXPECT_EQ(names(grains),
+            "body0/mass:1 body0/volume:1 body0/volume0:1 body0/x:2 body0/v:2 body0/C:4 body0/L:9 "
+            "body0/stress:9 body0/f_ext:2 body0/phi:1 body0/div_q:1 granular/f:1 granular/regime:1 "
+            "granular/gamma_dot_p:1 | position velocity stress pressure mass volume f phi tau_bar regime gamma_dot_p ");
+  Body<PlaneStrain> fluid = random_body(10, 2, 1000.0);
+  material::FluidParams fp;
+  fluid.set_law(std::make_unique<FluidLaw<PlaneStrain>>(fp, 0.2));
+  EXPECT_EQ(names(fluid),
+            "body0/mass:1 body0/volume:1 body0/volume0:1 body0/x:2 body0/v:2 body0/C:4 body0/L:9 "
+            "body0/stress:9 body0/f_ext:2 body0/phi:1 body0/div_q:1 fluid/ln_J:1 "
+            "| position velocity stress fluid_pressure mass volume phi J ");
 }

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "oobleck/mpm/fields.hpp"
 #include "oobleck/mpm/geometry.hpp"
 
 namespace oobleck::mpm {
@@ -65,6 +66,9 @@ class StressLaw {
   /// The NaN guard fused into the chunks' update: the lowest index of a point whose new stress is not
   /// finite, kAllFinite, or kNotChecked (the default: the runner then scans the stresses itself).
   virtual std::int64_t first_non_finite_stress() const { return kNotChecked; }
+  /// Declare the law's persistent per-point arrays (checkpoints) and what it adds to its body's
+  /// frames (mpm/fields.hpp); called after the body declared its own. Default: none.
+  virtual void declare_fields(Body<G>& /*body*/, FieldList& /*list*/) {}
 };
 
 template <class G>
@@ -88,6 +92,27 @@ struct Body {
   std::unique_ptr<StressLaw<G>> law;
 
   std::int64_t size() const { return static_cast<std::int64_t>(mass_kg.size()); }
+
+  /// The persistent fields (mpm/fields.hpp): the arrays above, in the checkpoints' order (the
+  /// law declares its own: StressLaw::declare_fields). Adding an array here puts it into
+  /// checkpoints (and frames, with a FrameForm).
+  void declare_fields(FieldList& list) {
+    list.add("mass", mass_kg, "kg", FrameForm::scalar);
+    list.add("volume", volume_m3, "m^3", FrameForm::scalar);
+    list.add("volume0", volume0_m3, "m^3");
+    list.add("x", x_m, "m", FrameForm::position, "position");
+    list.add("v", v_m_s, "m/s", FrameForm::vector, "velocity");
+    list.add("C", C_1_s, "1/s");
+    list.add("L", L_1_s, "1/s");
+    list.add("stress", stress_Pa, "Pa", FrameForm::sym_tensor);
+    list.derived("pressure", "Pa", [this](std::span<double> out) {
+      for (std::size_t p = 0; p < out.size(); ++p) out[p] = -stress_Pa[p].trace() / 3.0;
+    });
+    list.add("f_ext", f_ext_N, "N");
+    list.add("phi", phi, "1");
+    list.add("div_q", div_q_1_s, "1/s");
+    list.frame_order({"x", "v", "stress", "pressure", "mass", "volume"});
+  }
 
   /// Append one point at rest-state stress zero.
   void add_point(const Vec<D>& x, double volume, double density_kg_m3, const Vec<NC>& v = Vec<NC>::Zero()) {

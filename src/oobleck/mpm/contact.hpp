@@ -50,6 +50,7 @@
 
 #include "oobleck/mpm/body.hpp"
 #include "oobleck/mpm/boundary.hpp"
+#include "oobleck/mpm/fields.hpp"
 #include "oobleck/mpm/grid.hpp"
 #include "oobleck/mpm/shape.hpp"
 #include "oobleck/mpm/transfer.hpp"
@@ -73,6 +74,8 @@ struct RigidMotion {
   double mass_kg = 0.0;                    ///< Σ m_p (per radian in axisymmetric mode)
   Vec<NC> predicted_m_s = Vec<NC>::Zero(); ///< V + Δt g of the current step (internal)
   bool rigid() const { return kind != BodyMotion::Deformable; }
+  /// Persistent state (mpm/fields.hpp): the velocity (a FreeRigid body's is integrated).
+  void declare_fields(FieldList& list) { list.add_values("rigid_velocity", {velocity_m_s.data(), NC}, "m/s"); }
 };
 
 /// Contact between one solid body and the mixture (grains and/or fluid), model.md §8.
@@ -97,6 +100,8 @@ struct ContactPair {
   int active_nodes = 0;                    ///< nodes where an impulse acted, last step
   std::vector<Vec<G::dim>> mass_gradient;  ///< nodal ∇m_b (sized once)
   std::vector<double> volume_m3;           ///< nodal volume Σ N_ip V_p of the solid (sized once)
+  /// Persistent state (mpm/fields.hpp): the impulse sum (the other members are per step).
+  void declare_fields(FieldList& list) { list.add_values("impulse_sum", {impulse_sum_N_s.data(), NC}, "N s"); }
 };
 
 /// Velocity-level motor (model.md §8, wheel): before each step, the mean angular velocity of the

@@ -107,6 +107,18 @@ class GranularBodyLaw final : public StressLaw<G> {
   /// A non-finite result never reaches the stresses: end_update throws with the diagnosis.
   std::int64_t first_non_finite_stress() const override { return kAllFinite; }
   const material::GranularLaw& law() const { return law_; }
+  void declare_fields(Body<G>& body, FieldList& list) override {
+    list.group("granular");
+    list.add("f", f, "1", FrameForm::scalar);
+    list.derived("phi", "1", [this, &body](std::span<double> out) {
+      for (std::size_t p = 0; p < out.size(); ++p) out[p] = phi_of(body, static_cast<std::int64_t>(p));
+    });
+    list.derived("tau_bar", "Pa", [&body](std::span<double> out) {
+      for (std::size_t p = 0; p < out.size(); ++p) out[p] = material::tau_bar(body.stress_Pa[p]);
+    });
+    list.add("regime", regime, "1", FrameForm::scalar);
+    list.add("gamma_dot_p", gamma_dot_p, "1/s", FrameForm::scalar);
+  }
 
   std::vector<double> f;                 ///< micro-structure per point
   std::vector<std::uint8_t> regime;      ///< material::GranularRegime of the last step

@@ -83,6 +83,18 @@ class FluidLaw final : public StressLaw<G> {
   }
   const char* name() const override { return "fluid"; }
   const material::FluidParams& params() const { return p_; }
+  /// ln J (checkpoints before ln J stored J: read as its logarithm, which differs from an
+  /// uninterrupted run by that logarithm's round-off); the frames show the body's phi, its
+  /// pressure as fluid_pressure, and J = ρ_f0/ρ_f.
+  void declare_fields(Body<G>& /*body*/, FieldList& list) override {
+    list.show("pressure", FrameForm::scalar, "fluid_pressure");
+    list.show("phi", FrameForm::scalar);
+    list.group("fluid");
+    list.add("ln_J", ln_J, "1", FrameForm::none, {}, "J", [](double J) { return std::log(J); });
+    list.derived("J", "1", [this](std::span<double> out) {
+      for (std::size_t p = 0; p < out.size(); ++p) out[p] = std::exp(ln_J[p]);
+    });
+  }
   std::vector<double> ln_J;  ///< ln(ρ_f0/ρ_f) per point (E26: p_f = −κ ln J)
 
  private:

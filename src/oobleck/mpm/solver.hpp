@@ -189,6 +189,8 @@ class Solver {
   const ContactPair<G>& contact(int pair) const { return contacts_[pair]; }
   /// Restore a pair's accumulated impulse (checkpoint restart).
   void set_contact_impulse_sum(int pair, const Vec<NC>& J) { contacts_[pair].impulse_sum_N_s = J; }
+  /// Declare pair `pair`'s persistent fields (mpm/fields.hpp; restored in place).
+  void declare_contact_fields(int pair, FieldList& list) { contacts_[pair].declare_fields(list); }
   int contact_count() const { return static_cast<int>(contacts_.size()); }
   /// Contact force on body b from the mixture over the last step [N] (sum over its pairs; per
   /// radian in axisymmetric mode, per unit depth in plane strain).

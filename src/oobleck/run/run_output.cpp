@@ -4,10 +4,11 @@
 #include <array>
 #include <cmath>
 #include <type_traits>
+#include <variant>
 
 #include <fmt/format.h>
 
-#include "oobleck/material/granular.hpp"
+#include "oobleck/mpm/fields.hpp"
 #include "oobleck/run/nodal_fields.hpp"
 
 namespace oobleck::run {
@@ -27,55 +28,48 @@ class Columns {
   std::vector<std::vector<double>> store_;
 };
 
-/// Body b's points with their fields.
+/// Add field `f` (not the positions) to a frame's point cloud of n points.
+void add_to_cloud(io::PointCloud& cloud, const mpm::PersistentField& f, std::size_t n, Columns& column) {
+  const auto* d = std::get_if<std::span<double>>(&f.data);
+  const std::string& name = f.shown_as();
+  switch (f.frame) {
+    case mpm::FrameForm::vector: cloud.vector(name, f.width, *d); return;
+    case mpm::FrameForm::sym_tensor: {  // 3×3, column-major: (i, j) at i + 3 j
+      const int idx[6] = {0, 3, 6, 4, 7, 8};  // xx xy xz yy yz zz
+      std::array<std::vector<double>*, 6> c{};
+      for (int k = 0; k < 6; ++k) {
+        c[k] = &column.add(n);
+        for (std::size_t p = 0; p < n; ++p) (*c[k])[p] = (*d)[9 * p + static_cast<std::size_t>(idx[k])];
+      }
+      cloud.sym_tensor(name, {*c[0], *c[1], *c[2], *c[3], *c[4], *c[5]});
+      return;
+    }
+    default: break;  // scalars
+  }
+  if (f.derive) {
+    auto& values = column.add(n);
+    f.derive(values);
+    cloud.scalar(name, values);
+  } else if (const auto* u = std::get_if<std::span<std::uint8_t>>(&f.data)) {
+    auto& values = column.add(n);
+    for (std::size_t p = 0; p < n; ++p) values[p] = (*u)[p];
+    cloud.scalar(name, values);
+  } else {
+    cloud.scalar(name, *d);
+  }
+}
+
+/// Body b's points with the fields that it and its law declare for frames (mpm/fields.hpp).
 template <class G>
 io::PointCloud body_cloud(const scene::BuiltScene<G>& scene, int b, Columns& column) {
-  constexpr int D = G::dim, NC = G::ncomp;
-  const auto& body = scene.solver->body(b);
+  auto& body = scene.solver->body(b);
   const auto n = static_cast<std::size_t>(body.size());
-  std::array<std::vector<double>*, 3> pos{};
-  for (int a = 0; a < D; ++a) {
-    pos[a] = &column.add(n);
-    for (std::size_t p = 0; p < n; ++p) (*pos[a])[p] = body.x_m[p][a];
-  }
-  io::PointCloud cloud = D == 2 ? io::PointCloud(body.name, {*pos[0], *pos[1]})
-                                : io::PointCloud(body.name, {*pos[0], *pos[1], *pos[2]});
-  std::array<std::vector<double>*, 3> vel{};
-  for (int c = 0; c < NC; ++c) {
-    vel[c] = &column.add(n);
-    for (std::size_t p = 0; p < n; ++p) (*vel[c])[p] = body.v_m_s[p][c];
-  }
-  if (NC == 2) cloud.vector("velocity", {*vel[0], *vel[1]});
-  else cloud.vector("velocity", {*vel[0], *vel[1], *vel[2]});
-  std::array<std::vector<double>*, 6> s6{};
-  const int idx[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};
-  for (int k = 0; k < 6; ++k) {
-    s6[k] = &column.add(n);
-    for (std::size_t p = 0; p < n; ++p) (*s6[k])[p] = body.stress_Pa[p](idx[k][0], idx[k][1]);
-  }
-  cloud.sym_tensor("stress", {*s6[0], *s6[1], *s6[2], *s6[3], *s6[4], *s6[5]});
-  auto& pressure = column.add(n);
-  for (std::size_t p = 0; p < n; ++p) pressure[p] = -body.stress_Pa[p].trace() / 3.0;
-  cloud.scalar(b == scene.fluid ? "fluid_pressure" : "pressure", pressure);
-  cloud.scalar("mass", body.mass_kg).scalar("volume", body.volume_m3);
-  if (b == scene.grains) {
-    auto& law = *scene.granular_law;
-    auto& phi = column.add(n);
-    auto& tau = column.add(n);
-    auto& regime = column.add(n);
-    for (std::size_t p = 0; p < n; ++p) {
-      phi[p] = law.phi_of(body, static_cast<std::int64_t>(p));
-      tau[p] = material::tau_bar(body.stress_Pa[p]);
-      regime[p] = law.regime[p];
-    }
-    cloud.scalar("f", law.f).scalar("phi", phi).scalar("tau_bar", tau);
-    cloud.scalar("regime", regime).scalar("gamma_dot_p", law.gamma_dot_p);
-  }
-  if (b == scene.fluid) {
-    auto& J = column.add(n);  // (the frames show J = ρ_f0/ρ_f; the law's state is ln J)
-    for (std::size_t p = 0; p < n; ++p) J[p] = std::exp(scene.fluid_law->ln_J[p]);
-    cloud.scalar("phi", body.phi).scalar("J", J);
-  }
+  mpm::FieldList list;
+  body.declare_fields(list);
+  if (body.law) body.law->declare_fields(body, list);
+  const std::vector<const mpm::PersistentField*> shown = list.frame_fields();  // (positions first)
+  io::PointCloud cloud(body.name, shown.front()->width, std::get<std::span<double>>(shown.front()->data));
+  for (std::size_t k = 1; k < shown.size(); ++k) add_to_cloud(cloud, *shown[k], n, column);
   return cloud;
 }
 

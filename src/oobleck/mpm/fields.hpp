@@ -1,0 +1,149 @@
+#pragma once
+// The registry of persistent fields: every array that a restart needs or that the frames show is
+// declared once, by its owner, as a PersistentField in a FieldList. Checkpoint write and restore
+// (run/solver_state.cpp) and the frames (run/run_output.cpp) iterate that list; none of them
+// names a field.
+//
+// Owners and their declarations:
+//   Body<G>::declare_fields          the point arrays of every body (group "body<b>")
+//   StressLaw<G>::declare_fields     a law's per-point state (GranularBodyLaw: group "granular",
+//                                    FluidLaw: "fluid") and what it adds to its body's frames
+//   run/solver_state.cpp             the [[body]] entries' rigid velocity and contact impulse sum
+//                                    (group "third<k>")
+// A checkpoint dataset is "GROUP/NAME"; a frame field is NAME (or frame_name) of its body.
+#include <cstddef>
+#include <cstdint>
+#include <algorithm>
+#include <functional>
+#include <initializer_list>
+#include <span>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <variant>
+#include <vector>
+
+namespace oobleck::mpm {
+
+/// How a field appears in the frames (io/frames.hpp): not at all, as the body's positions, as a
+/// scalar, a vector (width 2 or 3), or a symmetric tensor (width 9, a 3×3 matrix in Eigen's
+/// column-major order; the frame shows xx xy xz yy yz zz).
+enum class FrameForm { none, position, scalar, vector, sym_tensor };
+
+/// One named array, `width` values per item, viewed in place (no copy).
+struct PersistentField {
+  std::string group;  ///< checkpoint group: "body0", "granular", "fluid", "third0"
+  std::string name;   ///< the dataset under the group ("x", "ln_J"); also the frame name
+  int width = 1;      ///< values per item (the dataset is stored flat: items × width)
+  const char* unit = "1";
+  /// The values, read for checkpoints and frames and written on restore. Empty (monostate) for a
+  /// field the frames derive (`derive`).
+  std::variant<std::monostate, std::span<double>, std::span<std::uint8_t>> data;
+  bool in_checkpoint = true;
+  FrameForm frame = FrameForm::none;
+  std::string frame_name;  ///< the frame's name when it differs from `name`
+  int frame_rank = 1 << 20;  ///< frames show fields by rank, then in declaration order
+  /// Frame-only field: fill one value per item (called when a frame is written).
+  std::function<void(std::span<double>)> derive;
+  /// Older checkpoints that stored this field as `legacy_name` (read when `name` is absent),
+  /// converted value by value with `from_legacy`.
+  std::string legacy_name;
+  double (*from_legacy)(double) = nullptr;
+
+  std::string dataset() const { return group + "/" + name; }
+  const std::string& shown_as() const { return frame_name.empty() ? name : frame_name; }
+};
+
+/// Values per element: 1 for a double, the size of a fixed-size Eigen vector or matrix.
+template <class T>
+constexpr int element_width() {
+  if constexpr (std::is_same_v<T, double>) return 1;
+  else return static_cast<int>(T::SizeAtCompileTime);
+}
+
+/// View a vector of fixed-size Eigen objects (or doubles) as doubles (stored without padding).
+template <class T>
+std::span<double> flat_doubles(std::vector<T>& v) {
+  if constexpr (std::is_same_v<T, double>) {
+    return {v.data(), v.size()};
+  } else {
+    static_assert(sizeof(T) == sizeof(double) * T::SizeAtCompileTime, "padded Eigen type");
+    return {reinterpret_cast<double*>(v.data()), v.size() * static_cast<std::size_t>(T::SizeAtCompileTime)};
+  }
+}
+
+/// The declarations of one or more owners, in declaration order (the frames' order).
+class FieldList {
+ public:
+  /// Following declarations belong to checkpoint group `g`.
+  void group(std::string g) { group_ = std::move(g); }
+
+  /// A per-item array of doubles or Eigen vectors/matrices; width from the element type. Shown
+  /// in the frames as `frame` (under `frame_name` if not empty); `legacy_name`, `from_legacy`:
+  /// see PersistentField.
+  template <class T>
+  PersistentField& add(std::string name, std::vector<T>& v, const char* unit, FrameForm frame = FrameForm::none,
+                       std::string frame_name = {}, std::string legacy_name = {},
+                       double (*from_legacy)(double) = nullptr) {
+    return push({group_, std::move(name), element_width<T>(), unit, flat_doubles(v), true, frame,
+                 std::move(frame_name), 1 << 20, {}, std::move(legacy_name), from_legacy});
+  }
+  PersistentField& add(std::string name, std::vector<std::uint8_t>& v, const char* unit,
+                       FrameForm frame = FrameForm::none) {
+    return push({group_, std::move(name), 1, unit, std::span<std::uint8_t>(v), true, frame, {}, 1 << 20, {}, {},
+                 nullptr});
+  }
+  /// A fixed-size array of `width` doubles (one item; e.g. a rigid body's velocity).
+  PersistentField& add_values(std::string name, std::span<double> values, const char* unit) {
+    const int width = static_cast<int>(values.size());
+    return push({group_, std::move(name), width, unit, values, true, FrameForm::none, {}, 1 << 20, {}, {}, nullptr});
+  }
+  /// A scalar the frames compute from other fields (not in checkpoints).
+  PersistentField& derived(std::string name, const char* unit, std::function<void(std::span<double>)> fill) {
+    return push({group_, std::move(name), 1, unit, {}, false, FrameForm::scalar, {}, 1 << 20, std::move(fill), {},
+                 nullptr});
+  }
+  /// Show an already declared field of the current group in the frames, as `form`, under
+  /// `frame_name` if given (e.g. the fluid law shows its body's phi, and its pressure as
+  /// "fluid_pressure").
+  void show(const std::string& name, FrameForm form, std::string frame_name = {}) {
+    for (auto& f : fields_) {
+      if (f.group != group_ || f.name != name) continue;
+      f.frame = form;
+      f.frame_name = std::move(frame_name);
+      return;
+    }
+  }
+
+  /// The frames show these fields of the current group first, in this order (then the others
+  /// in declaration order).
+  void frame_order(std::initializer_list<const char*> names) {
+    int rank = 0;
+    for (const char* n : names) {
+      for (auto& f : fields_)
+        if (f.group == group_ && f.name == n) f.frame_rank = rank;
+      ++rank;
+    }
+  }
+
+  /// In declaration order (the checkpoints' order).
+  const std::vector<PersistentField>& fields() const { return fields_; }
+  /// The fields the frames show, in the frames' order.
+  std::vector<const PersistentField*> frame_fields() const {
+    std::vector<const PersistentField*> shown;
+    for (const auto& f : fields_)
+      if (f.frame != FrameForm::none) shown.push_back(&f);
+    std::stable_sort(shown.begin(), shown.end(), [](auto* a, auto* b) { return a->frame_rank < b->frame_rank; });
+    return shown;
+  }
+
+ private:
+  PersistentField& push(PersistentField f) {
+    fields_.push_back(std::move(f));
+    return fields_.back();
+  }
+  std::string group_;
+  std::vector<PersistentField> fields_;
+};
+
+}  // namespace oobleck::mpm
