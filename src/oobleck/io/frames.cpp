@@ -306,6 +306,88 @@ FrameWriter FrameWriter::resume(std::string run_dir, std::int64_t last_step, std
   return w;
 }
 
+namespace {
+
+/// One body's group of a frame file (positions, vertex list, fields) and its XDMF grid block.
+std::string write_body_block(hid_t bodies, const PointCloud& b, const std::string& rel, const std::string& time_xml) {
+  h5::Handle g = h5::create_group(bodies, b.name());
+  const std::size_t n = b.count();
+  const std::vector<std::uint64_t> pshape{n, static_cast<std::uint64_t>(b.dim())};
+  if (b.positions().size() == 1) {
+    h5::write_dataset(g.get(), "position", H5T_NATIVE_DOUBLE, pshape, b.positions()[0].data());
+  } else {
+    const auto buf = interleave(b.positions(), n, b.dim(), b.dim());
+    h5::write_dataset(g.get(), "position", H5T_NATIVE_DOUBLE, pshape, buf.data());
+  }
+  // Explicit vertex list 0..N-1: the Xdmf3 readers make no cells of a Polyvertex topology
+  // without one (points then do not render); the XDMF (2) reader accepts it too.
+  const bool small = n <= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
+  if (small) {
+    std::vector<std::int32_t> conn(n);
+    for (std::size_t i = 0; i < n; ++i) conn[i] = static_cast<std::int32_t>(i);
+    h5::write_dataset(g.get(), "connectivity", H5T_NATIVE_INT32, {n}, conn.data());
+  } else {
+    std::vector<std::int64_t> conn(n);
+    for (std::size_t i = 0; i < n; ++i) conn[i] = static_cast<std::int64_t>(i);
+    h5::write_dataset(g.get(), "connectivity", H5T_NATIVE_INT64, {n}, conn.data());
+  }
+  h5::write_attribute(g.get(), "count", static_cast<std::int64_t>(n));
+  std::string xml;
+  const std::string prefix = fmt::format("{}:/bodies/{}", rel, b.name());
+  xml += fmt::format("    <Grid Name=\"{}\" GridType=\"Uniform\">\n", b.name());
+  xml += time_xml;
+  xml += fmt::format("      <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"{}\" NodesPerElement=\"1\">\n", n);
+  xml += fmt::format(
+      "        <DataItem Dimensions=\"{}\" NumberType=\"Int\" Precision=\"{}\" Format=\"HDF\">{}/connectivity</DataItem>\n",
+      n, small ? 4 : 8, prefix);
+  xml += "      </Topology>\n";
+  xml += fmt::format("      <Geometry GeometryType=\"{}\">\n", b.dim() == 2 ? "XY" : "XYZ");
+  xml += fmt::format("        {}\n", hdf_item(pshape, prefix + "/position"));
+  xml += "      </Geometry>\n";
+  for (const auto& f : b.fields()) write_field(g.get(), prefix, f, n, {n}, xml, "      ");
+  xml += "    </Grid>\n";
+  h5::write_attribute(g.get(), "xdmf", xml);
+  return xml;
+}
+
+/// The grid's group of a frame file (origin, spacing, nodal fields) and its XDMF grid block.
+std::string write_grid_block(hid_t file, const NodeGrid& grid, const std::string& rel, const std::string& time_xml) {
+  h5::Handle g = h5::create_group(file, "grid");
+  const auto& o = grid.origin();
+  const auto& h = grid.spacing();
+  const auto& nn = grid.nodes();
+  h5::write_attribute(g.get(), "origin", std::vector<double>{o[0], o[1], o[2]});
+  h5::write_attribute(g.get(), "spacing", std::vector<double>{h[0], h[1], h[2]});
+  h5::write_attribute(g.get(), "nodes", std::vector<std::int64_t>{static_cast<std::int64_t>(nn[0]),
+                                                                  static_cast<std::int64_t>(nn[1]),
+                                                                  static_cast<std::int64_t>(nn[2])});
+  h5::write_attribute(g.get(), "dim", static_cast<std::int64_t>(grid.dim()));
+  // A 2D grid is written as one layer of a 3D mesh: VTK's XDMF readers place a
+  // 2DCoRectMesh in the y-z plane, away from the XY points; a 3DCoRectMesh with nz = 1
+  // lies in the x-y plane.
+  const std::vector<std::uint64_t> lead{nn[2], nn[1], nn[0]};
+  std::string xml;
+  xml += fmt::format("    <Grid Name=\"{}\" GridType=\"Uniform\">\n", kGridBlock);
+  xml += time_xml;
+  xml += fmt::format("      <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"{}\"/>\n", dims_text(lead));
+  xml += "      <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n";
+  xml += fmt::format(
+      "        <DataItem Name=\"Origin\" Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" "
+      "Format=\"XML\">{:.17g} {:.17g} {:.17g}</DataItem>\n",
+      o[2], o[1], o[0]);
+  xml += fmt::format(
+      "        <DataItem Name=\"Spacing\" Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" "
+      "Format=\"XML\">{:.17g} {:.17g} {:.17g}</DataItem>\n",
+      h[2], h[1], h[0]);
+  xml += "      </Geometry>\n";
+  for (const auto& f : grid.fields()) write_field(g.get(), rel + ":/grid", f, grid.count(), lead, xml, "      ");
+  xml += "    </Grid>\n";
+  h5::write_attribute(g.get(), "xdmf", xml);
+  return xml;
+}
+
+}  // namespace
+
 std::string FrameWriter::write(const Frame& frame) {
   const std::size_t index = entries_.size();
   const std::string path = frame_path(index);
@@ -332,83 +414,16 @@ std::string FrameWriter::write(const Frame& frame) {
     h5::write_attribute(file.get(), "format", std::string("oobleck-frame-1"));
     h5::Handle bodies = h5::create_group(file.get(), "bodies");
     for (const auto& b : frame.bodies) {
-      h5::Handle g = h5::create_group(bodies.get(), b.name());
-      const std::size_t n = b.count();
-      const std::vector<std::uint64_t> pshape{n, static_cast<std::uint64_t>(b.dim())};
-      if (b.positions().size() == 1) {
-        h5::write_dataset(g.get(), "position", H5T_NATIVE_DOUBLE, pshape, b.positions()[0].data());
-      } else {
-        const auto buf = interleave(b.positions(), n, b.dim(), b.dim());
-        h5::write_dataset(g.get(), "position", H5T_NATIVE_DOUBLE, pshape, buf.data());
-      }
-      // Explicit vertex list 0..N-1: the Xdmf3 readers make no cells of a Polyvertex topology
-      // without one (points then do not render); the XDMF (2) reader accepts it too.
-      const bool small = n <= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
-      if (small) {
-        std::vector<std::int32_t> conn(n);
-        for (std::size_t i = 0; i < n; ++i) conn[i] = static_cast<std::int32_t>(i);
-        h5::write_dataset(g.get(), "connectivity", H5T_NATIVE_INT32, {n}, conn.data());
-      } else {
-        std::vector<std::int64_t> conn(n);
-        for (std::size_t i = 0; i < n; ++i) conn[i] = static_cast<std::int64_t>(i);
-        h5::write_dataset(g.get(), "connectivity", H5T_NATIVE_INT64, {n}, conn.data());
-      }
-      h5::write_attribute(g.get(), "count", static_cast<std::int64_t>(n));
-      std::string xml;
-      const std::string prefix = fmt::format("{}:/bodies/{}", rel, b.name());
-      xml += fmt::format("    <Grid Name=\"{}\" GridType=\"Uniform\">\n", b.name());
-      xml += time_xml;
-      xml += fmt::format("      <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"{}\" NodesPerElement=\"1\">\n", n);
-      xml += fmt::format(
-          "        <DataItem Dimensions=\"{}\" NumberType=\"Int\" Precision=\"{}\" Format=\"HDF\">{}/connectivity</DataItem>\n",
-          n, small ? 4 : 8, prefix);
-      xml += "      </Topology>\n";
-      xml += fmt::format("      <Geometry GeometryType=\"{}\">\n", b.dim() == 2 ? "XY" : "XYZ");
-      xml += fmt::format("        {}\n", hdf_item(pshape, prefix + "/position"));
-      xml += "      </Geometry>\n";
-      for (const auto& f : b.fields()) write_field(g.get(), prefix, f, n, {n}, xml, "      ");
-      xml += "    </Grid>\n";
-      h5::write_attribute(g.get(), "xdmf", xml);
+      std::string xml = write_body_block(bodies.get(), b, rel, time_xml);
       // ParaView rejects a Polyvertex grid of zero points: an empty body stays in the HDF5 file
       // (so its fields are still listed) but not in the index of this frame.
-      if (n > 0) {
+      if (b.count() > 0) {
         entry.blocks.emplace_back(b.name(), std::move(xml));
         block_list += b.name() + "\n";
       }
     }
     if (frame.grid) {
-      const NodeGrid& grid = *frame.grid;
-      h5::Handle g = h5::create_group(file.get(), "grid");
-      const auto& o = grid.origin();
-      const auto& h = grid.spacing();
-      const auto& nn = grid.nodes();
-      h5::write_attribute(g.get(), "origin", std::vector<double>{o[0], o[1], o[2]});
-      h5::write_attribute(g.get(), "spacing", std::vector<double>{h[0], h[1], h[2]});
-      h5::write_attribute(g.get(), "nodes", std::vector<std::int64_t>{static_cast<std::int64_t>(nn[0]),
-                                                                      static_cast<std::int64_t>(nn[1]),
-                                                                      static_cast<std::int64_t>(nn[2])});
-      h5::write_attribute(g.get(), "dim", static_cast<std::int64_t>(grid.dim()));
-      // A 2D grid is written as one layer of a 3D mesh: VTK's XDMF readers place a
-      // 2DCoRectMesh in the y-z plane, away from the XY points; a 3DCoRectMesh with nz = 1
-      // lies in the x-y plane.
-      const std::vector<std::uint64_t> lead{nn[2], nn[1], nn[0]};
-      std::string xml;
-      xml += fmt::format("    <Grid Name=\"{}\" GridType=\"Uniform\">\n", kGridBlock);
-      xml += time_xml;
-      xml += fmt::format("      <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"{}\"/>\n", dims_text(lead));
-      xml += "      <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n";
-      xml += fmt::format(
-          "        <DataItem Name=\"Origin\" Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" "
-          "Format=\"XML\">{:.17g} {:.17g} {:.17g}</DataItem>\n",
-          o[2], o[1], o[0]);
-      xml += fmt::format(
-          "        <DataItem Name=\"Spacing\" Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" "
-          "Format=\"XML\">{:.17g} {:.17g} {:.17g}</DataItem>\n",
-          h[2], h[1], h[0]);
-      xml += "      </Geometry>\n";
-      for (const auto& f : grid.fields()) write_field(g.get(), rel + ":/grid", f, grid.count(), lead, xml, "      ");
-      xml += "    </Grid>\n";
-      h5::write_attribute(g.get(), "xdmf", xml);
+      std::string xml = write_grid_block(file.get(), *frame.grid, rel, time_xml);
       entry.blocks.emplace_back(kGridBlock, std::move(xml));
       block_list += std::string(kGridBlock) + "\n";
     }
