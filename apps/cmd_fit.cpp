@@ -32,10 +32,14 @@ constexpr const char* kDefaultPreset = "hermes2016";
 std::string sanitize(const std::string& s) {
   std::string out;
   for (char c : s) {
-    if (c == '"') out += '\'';
-    else if (c == '\\') out += '/';
-    else if (static_cast<unsigned char>(c) < 0x20) out += ' ';
-    else out += c;
+    if (c == '"')
+      out += '\'';
+    else if (c == '\\')
+      out += '/';
+    else if (static_cast<unsigned char>(c) < 0x20)
+      out += ' ';
+    else
+      out += c;
   }
   return out;
 }
@@ -64,19 +68,22 @@ Data read_data(const std::string& path, rheology::FitKind kind, double eta_0) {
   double scale = 1.0;
   if (kind == rheology::FitKind::dst) {
     if (!t.has_column("shear_rate_dst")) {
-      throw InputError(fmt::format("{}: missing column 'shear_rate_dst' [1/s] (columns present: {}); --kind dst "
-                                   "needs phi,shear_rate_dst",
-                                   path, fmt::join(t.header, ", ")));
+      throw InputError(
+          fmt::format("{}: missing column 'shear_rate_dst' [1/s] (columns present: {}); --kind dst "
+                      "needs phi,shear_rate_dst",
+                      path, fmt::join(t.header, ", ")));
     }
     d.column = "shear_rate_dst";
   } else {
     const bool visc = t.has_column("viscosity"), rel = t.has_column("relative_viscosity");
     if (visc == rel) {
-      throw InputError(fmt::format("{}: {} (columns present: {}); --kind {} needs phi and exactly one of "
-                                   "viscosity [Pa s] or relative_viscosity [-]",
-                                   path, visc ? "both 'viscosity' and 'relative_viscosity' given" :
-                                                "missing column 'viscosity' or 'relative_viscosity'",
-                                   fmt::join(t.header, ", "), rheology::to_string(kind)));
+      throw InputError(
+          fmt::format("{}: {} (columns present: {}); --kind {} needs phi and exactly one of "
+                      "viscosity [Pa s] or relative_viscosity [-]",
+                      path,
+                      visc ? "both 'viscosity' and 'relative_viscosity' given"
+                           : "missing column 'viscosity' or 'relative_viscosity'",
+                      fmt::join(t.header, ", "), rheology::to_string(kind)));
     }
     d.column = visc ? "viscosity" : "relative_viscosity";
     if (visc) scale = 1.0 / eta_0;  // eta_r = viscosity/eta_0
@@ -88,8 +95,8 @@ Data read_data(const std::string& path, rheology::FitKind kind, double eta_0) {
       throw InputError(fmt::format("{}: data row {}: column 'phi' = {}: must lie in (0, 1)", path, k + 1, d.phi[k]));
     }
     if (!(raw[k] > 0.0)) {
-      throw InputError(fmt::format("{}: data row {}: column '{}' = {}: must be positive", path, k + 1, d.column,
-                                   raw[k]));
+      throw InputError(
+          fmt::format("{}: data row {}: column '{}' = {}: must be positive", path, k + 1, d.column, raw[k]));
     }
     d.values.push_back(raw[k] * scale);
   }
@@ -139,7 +146,8 @@ std::string plot_fit(const rheology::FitResult& r, const Data& d, const std::str
   const double phi_m = r.kind == FitKind::high ? r.params.phi_c : r.params.phi_j;
   const double start = r.kind == FitKind::dst ? r.params.phi_c : std::max(0.0, phi_lo - 0.05 * (phi_m - phi_lo));
   const double gap_hi = phi_m - start;
-  const double gap_lo = r.kind == FitKind::dst ? 0.5 * (phi_m - phi_hi) : std::min(0.5 * (phi_m - phi_hi), 1e-3 * gap_hi);
+  const double gap_lo =
+      r.kind == FitKind::dst ? 0.5 * (phi_m - phi_hi) : std::min(0.5 * (phi_m - phi_hi), 1e-3 * gap_hi);
   std::string c = "phi,model\n";
   constexpr int kPoints = 300;
   for (int k = 0; k < kPoints; ++k) {
@@ -166,8 +174,9 @@ std::string plot_fit(const rheology::FitResult& r, const Data& d, const std::str
 
 void add_fit_command(CLI::App& rheology) {
   auto* cmd = rheology.add_subcommand(
-      "fit", "fit model parameters to rheometer data with Ceres: low (a_0, phi_j; E12), high (a_inf, phi_c; E13), "
-             "dst (eta_B terms; E14)");
+      "fit",
+      "fit model parameters to rheometer data with Ceres: low (a_0, phi_j; E12), high (a_inf, phi_c; E13), "
+      "dst (eta_B terms; E14)");
   struct Opts {
     ParamsOption params;
     std::string kind, data, out, png;
@@ -201,8 +210,8 @@ void add_fit_command(CLI::App& rheology) {
     rheology::Preset preset = o->params.load(kDefaultPreset);
     std::string note;
     if (default_base) {
-      note = fmt::format("no --preset or --params given: using the {} preset as the base parameter set",
-                         kDefaultPreset);
+      note =
+          fmt::format("no --preset or --params given: using the {} preset as the base parameter set", kDefaultPreset);
       fmt::print(o->json ? stderr : stdout, "{}\n", note);
     }
     const Data d = read_data(o->data, kind, preset.steady.eta_0);
@@ -227,9 +236,9 @@ void add_fit_command(CLI::App& rheology) {
 
     std::string tmp_png;
     if (!o->png.empty()) {
-      tmp_png = plot_fit(r, d, fmt::format("{}: fit --kind {} (base {})", fs::path(o->data).filename().string(),
-                                            o->kind, preset.name),
-                         o->png);
+      tmp_png = plot_fit(
+          r, d, fmt::format("{}: fit --kind {} (base {})", fs::path(o->data).filename().string(), o->kind, preset.name),
+          o->png);
     }
     try {
       io::write_file_atomically(o->out, toml_header(r, o->data, base_desc) + rheology::to_toml(fitted), "--out");
@@ -246,15 +255,18 @@ void add_fit_command(CLI::App& rheology) {
     if (r.rms > 0.1) {
       const std::string hint =
           kind == rheology::FitKind::dst
-              ? fmt::format("check the units (shear_rate_dst in 1/s), the base set (phi_c, phi_j, tau_star, eta_0 = "
-                            "{} Pa s) and the number of eta_B terms (--terms)",
-                            preset.steady.eta_0)
-              : fmt::format("check the units (viscosity in Pa s, eta_0 = {} Pa s of the base set) and that the "
-                            "points are {} viscosities",
-                            preset.steady.eta_0, kind == rheology::FitKind::low ? "minimum" : "plateau (maximum)");
-      warning = fmt::format("warning: rms log residual {:.3g} > 0.1 (more than 10 % scatter): the fitted {} "
-                            "asymptote does not describe these data well; {}",
-                            r.rms, rheology::to_string(kind), hint);
+              ? fmt::format(
+                    "check the units (shear_rate_dst in 1/s), the base set (phi_c, phi_j, tau_star, eta_0 = "
+                    "{} Pa s) and the number of eta_B terms (--terms)",
+                    preset.steady.eta_0)
+              : fmt::format(
+                    "check the units (viscosity in Pa s, eta_0 = {} Pa s of the base set) and that the "
+                    "points are {} viscosities",
+                    preset.steady.eta_0, kind == rheology::FitKind::low ? "minimum" : "plateau (maximum)");
+      warning = fmt::format(
+          "warning: rms log residual {:.3g} > 0.1 (more than 10 % scatter): the fitted {} "
+          "asymptote does not describe these data well; {}",
+          r.rms, rheology::to_string(kind), hint);
     }
     if (o->json) {
       if (!warning.empty()) fmt::print(stderr, "{}\n", warning);
@@ -263,19 +275,13 @@ void add_fit_command(CLI::App& rheology) {
         params[p.name] = {{"value", p.value},
                           {"std_error", std::isfinite(p.std_error) ? nlohmann::json(p.std_error) : nlohmann::json()}};
       }
-      nlohmann::json j = {{"kind", rheology::to_string(kind)},
-                          {"parameters", params},
-                          {"n", r.n},
-                          {"rms", r.rms},
-                          {"iterations", r.iterations},
-                          {"base", preset.name},
-                          {"out", o->out}};
+      nlohmann::json j = {{"kind", rheology::to_string(kind)}, {"parameters", params}, {"n", r.n},     {"rms", r.rms},
+                          {"iterations", r.iterations},        {"base", preset.name},  {"out", o->out}};
       if (!note.empty()) j["note"] = note;
       fmt::print("{}\n", j.dump());
       return;
     }
-    fmt::print("base parameter set: {} [{} units]; mu_c = {} (fixed)\n", base_desc, preset.units,
-               preset.steady.mu_c);
+    fmt::print("base parameter set: {} [{} units]; mu_c = {} (fixed)\n", base_desc, preset.units, preset.steady.mu_c);
     fmt::print("fit --kind {} to {}: n = {} points, p = {} parameters; Ceres converged ({} iterations)\n", o->kind,
                o->data, r.n, r.p, r.iterations);
     std::size_t width = 0;
@@ -286,9 +292,10 @@ void add_fit_command(CLI::App& rheology) {
                  unit_of(p.name), std::isfinite(rel) ? fmt::format("({:.2g} %)", 100.0 * rel) : "");
     }
     if (!r.covariance_ok) {
-      fmt::print("  standard errors n/a: the parameters are not all identifiable from these data (rank-deficient "
-                 "Jacobian){}\n",
-                 kind == rheology::FitKind::dst ? "; fit fewer eta_B terms (--terms)" : "");
+      fmt::print(
+          "  standard errors n/a: the parameters are not all identifiable from these data (rank-deficient "
+          "Jacobian){}\n",
+          kind == rheology::FitKind::dst ? "; fit fewer eta_B terms (--terms)" : "");
     }
     fmt::print("rms log residual = {:.4g} (n = {})\n", r.rms, r.n);
     if (!warning.empty()) fmt::print("{}\n", warning);

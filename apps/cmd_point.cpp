@@ -18,7 +18,6 @@
 namespace oobleck::cli {
 namespace {
 
-
 /// Material overrides shared by the point commands; NaN means "keep the parameter set's value".
 struct MaterialOverrides {
   double G = NAN, K = NAN, K0 = NAN, d = NAN, rho_s = NAN, mu_2 = NAN, b = NAN, K_3 = NAN, eta_0 = NAN;
@@ -88,7 +87,8 @@ class ProgressPrinter {
 };
 
 void shear_command(CLI::App& point) {
-  auto* cmd = point.add_subcommand("shear", "homogeneous simple shear at fixed volume (E16–E24), rate- or stress-controlled");
+  auto* cmd =
+      point.add_subcommand("shear", "homogeneous simple shear at fixed volume (E16–E24), rate- or stress-controlled");
   struct Opts {
     ParamsOption params;
     MaterialOverrides mat;
@@ -142,8 +142,9 @@ void shear_command(CLI::App& point) {
     so.samples = o->samples;
     if (so.dt <= 0.0) {
       const double rate_scale =
-          by_stress ? o->stress / (p.steady.eta_0 * rheology::eta_r_low(p.steady, std::min(o->phi, 0.999 * p.steady.phi_j)))
-                    : o->rate;
+          by_stress
+              ? o->stress / (p.steady.eta_0 * rheology::eta_r_low(p.steady, std::min(o->phi, 0.999 * p.steady.phi_j)))
+              : o->rate;
       so.dt = material::default_dt(law, o->phi, rate_scale, o->duration);
       fmt::print("dt = {:.4g} s (default{})\n", so.dt,
                  so.dt <= o->duration / 2e7 * (1.0 + 1e-12) ? "; floored at duration/2e7: eta/G is not resolved" : "");
@@ -163,14 +164,15 @@ void shear_command(CLI::App& point) {
     }
     csv.commit();
     const auto& last = res.samples.back();
-    fmt::print("wrote {} ({} steps of {:.4g} s; final: shear rate {:.6g} 1/s, tau {:.6g} Pa, tau_bar {:.6g} Pa, "
-               "p {:.6g} Pa, f {:.6g}, regime {})\n",
-               o->out, res.steps, res.dt, last.shear_rate, last.shear_stress, last.granular_shear_stress,
-               last.granular_pressure, last.f, material::regime_name(last.regime));
+    fmt::print(
+        "wrote {} ({} steps of {:.4g} s; final: shear rate {:.6g} 1/s, tau {:.6g} Pa, tau_bar {:.6g} Pa, "
+        "p {:.6g} Pa, f {:.6g}, regime {})\n",
+        o->out, res.steps, res.dt, last.shear_rate, last.shear_stress, last.granular_shear_stress,
+        last.granular_pressure, last.f, material::regime_name(last.regime));
     if (!o->png.empty()) {
-      const std::string title = fmt::format("{}, phi = {}, {}", p.name, o->phi,
-                                            by_stress ? fmt::format("tau = {} Pa", o->stress)
-                                                      : fmt::format("shear rate = {} 1/s", o->rate));
+      const std::string title =
+          fmt::format("{}, phi = {}, {}", p.name, o->phi,
+                      by_stress ? fmt::format("tau = {} Pa", o->stress) : fmt::format("shear rate = {} 1/s", o->rate));
       plot("plot_point_shear.py", {o->out, "--title", title}, o->png);
       fmt::print("wrote {}\n", o->png);
     }
@@ -199,7 +201,8 @@ void relax_command(CLI::App& point) {
   r->excludes(s);
   s->excludes(r);
   cmd->add_option("--duration", o->duration, "relaxation time after cessation [s]")->required();
-  cmd->add_option("--dt", o->dt, "first relaxation step [s] (default: 1/20 of c(f_0) eta_0/G); later dt = max(dt, t/50)");
+  cmd->add_option("--dt", o->dt,
+                  "first relaxation step [s] (default: 1/20 of c(f_0) eta_0/G); later dt = max(dt, t/50)");
   cmd->add_option("--samples", o->samples, "CSV rows per case (log-spaced in time)")->capture_default_str();
   cmd->add_option("--out", o->out, "output CSV file")->required();
   cmd->add_option("--plot", o->png, "also plot tau_bar(t)/tau_bar_0 and f(t) with the reduced ODE to this PNG");
@@ -247,15 +250,17 @@ void relax_command(CLI::App& point) {
         ProgressPrinter progress(fmt::format("point relax G = {:g} Pa, K_0 = {:g}", G, K0));
         results.push_back(material::run_relax(law, ro, std::ref(progress)));
         const auto& rr = results.back();
-        fmt::print("G = {:g} Pa, K_0 = {:g}: steady tau_bar_0 = {:.6g} Pa, p_0 = {:.6g} Pa, f_0 = {:.6g} after {:.4g} "
-                   "strain; initial relaxation time c(f_0) eta_0/G = {:.4g} s; tau_bar(end)/tau_bar_0 = {:.4g}\n",
-                   G, K0, rr.tau_bar_0, rr.p_0, rr.f_0, rr.preshear_strain, rr.relaxation_time_0,
-                   rr.samples.back().tau_bar / rr.tau_bar_0);
+        fmt::print(
+            "G = {:g} Pa, K_0 = {:g}: steady tau_bar_0 = {:.6g} Pa, p_0 = {:.6g} Pa, f_0 = {:.6g} after {:.4g} "
+            "strain; initial relaxation time c(f_0) eta_0/G = {:.4g} s; tau_bar(end)/tau_bar_0 = {:.4g}\n",
+            G, K0, rr.tau_bar_0, rr.p_0, rr.f_0, rr.preshear_strain, rr.relaxation_time_0,
+            rr.samples.back().tau_bar / rr.tau_bar_0);
       }
     }
     io::OutputFile csv(o->out, "--out");
     auto& st = csv.stream();
-    st << "case,G,K_0,time,granular_shear_stress,granular_pressure,f,gamma_dot_p,regime,ode_granular_shear_stress,ode_f\n";
+    st << "case,G,K_0,time,granular_shear_stress,granular_pressure,f,gamma_dot_p,regime,ode_granular_shear_stress,ode_"
+          "f\n";
     for (std::size_t c = 0; c < results.size(); ++c) {
       for (const auto& x : results[c].samples) {
         st << fmt::format("{},{},{},{},{},{},{},{},{},{},{}\n", c, num(results[c].G), num(results[c].K_0), num(x.time),
@@ -266,9 +271,9 @@ void relax_command(CLI::App& point) {
     csv.commit();
     fmt::print("wrote {} ({} cases)\n", o->out, results.size());
     if (!o->png.empty()) {
-      const std::string title = fmt::format("{}, phi = {}, pre-shear {}", base.name, o->phi,
-                                            by_stress ? fmt::format("tau = {} Pa", o->stress)
-                                                      : fmt::format("{} 1/s", o->rate));
+      const std::string title =
+          fmt::format("{}, phi = {}, pre-shear {}", base.name, o->phi,
+                      by_stress ? fmt::format("tau = {} Pa", o->stress) : fmt::format("{} 1/s", o->rate));
       plot("plot_point_relax.py", {o->out, "--title", title}, o->png);
       fmt::print("wrote {}\n", o->png);
     }

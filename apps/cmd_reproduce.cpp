@@ -52,7 +52,8 @@ struct Reproduction {
     fs::remove(out + "/log.txt.part");
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     commands.push_back(fmt::format("oobleck {}  # {:.1f} s", args, s));
-    if (rc != 0) throw NumericalError(fmt::format("reproduce: step '{}' failed (see {}/log.txt): oobleck {}", what, out, args));
+    if (rc != 0)
+      throw NumericalError(fmt::format("reproduce: step '{}' failed (see {}/log.txt): oobleck {}", what, out, args));
   }
   nlohmann::json summary(const std::string& run) const {
     std::ifstream in(out + "/" + run + "/summary.json");
@@ -67,7 +68,8 @@ struct Reproduction {
 void steady(Reproduction& r) {
   const std::string d = r.out + "/steady";
   fs::create_directories(d);
-  const std::string singh = "--phi 0.45 --phi 0.50 --phi 0.54 --phi 0.56 --phi 0.57 --phi 0.58 --phi 0.60 --phi 0.62 --phi 0.63 --phi 0.64";
+  const std::string singh =
+      "--phi 0.45 --phi 0.50 --phi 0.54 --phi 0.56 --phi 0.57 --phi 0.58 --phi 0.60 --phi 0.62 --phi 0.63 --phi 0.64";
   for (const char* p : {"singh2018a", "singh2018b"}) {
     r.oobleck(fmt::format("rheology flow-curve --preset {} {} --out {}/{}.csv --plot {}/{}.png", p, singh, d, p, d, p),
               fmt::format("Fig. 1 flow curves ({})", p));
@@ -75,20 +77,23 @@ void steady(Reproduction& r) {
   }
   const std::vector<std::tuple<std::string, double, double>> exp = {
       {"dhaene1993", 0.57, 0.65}, {"frith1996", 0.548, 0.642}, {"guy2015a", 0.56, 0.617},
-      {"guy2015b", 0.563, 0.610}, {"fall2015", 0.38, 0.454},  {"hermes2016", 0.436, 0.535}};
+      {"guy2015b", 0.563, 0.610}, {"fall2015", 0.38, 0.454},   {"hermes2016", 0.436, 0.535}};
   for (const auto& [name, pc, pj] : exp) {
     std::string phis;
-    for (double x : {0.85 * pc, 0.92 * pc, 0.97 * pc, pc, pc + 0.25 * (pj - pc), pc + 0.5 * (pj - pc), pc + 0.75 * (pj - pc)})
+    for (double x :
+         {0.85 * pc, 0.92 * pc, 0.97 * pc, pc, pc + 0.25 * (pj - pc), pc + 0.5 * (pj - pc), pc + 0.75 * (pj - pc)})
       phis += fmt::format(" --phi {:.4f}", x);
-    r.oobleck(fmt::format("rheology flow-curve --preset {}{} --out {}/{}.csv --plot {}/{}.png", name, phis, d, name, d, name),
-              fmt::format("Fig. 2 flow curves ({})", name));
+    r.oobleck(
+        fmt::format("rheology flow-curve --preset {}{} --out {}/{}.csv --plot {}/{}.png", name, phis, d, name, d, name),
+        fmt::format("Fig. 2 flow curves ({})", name));
     r.figures.push_back(fmt::format("{}/{}.png", d, name));
   }
   r.oobleck(fmt::format("rheology structure --preset singh2018a --out {}/structure.csv --plot {}/structure.png", d, d),
             "SI figure: f(tau) vs Wyart-Cates and Singh");
   r.figures.push_back(d + "/structure.png");
   r.oobleck(fmt::format("point relax --preset hermes2016 --phi 0.52 --shear-stress 100 --G 1e4 --G 1e5 --G 1e6 "
-                        "--K0 1 --duration 1 --out {}/relaxation.csv --plot {}/relaxation.png", d, d),
+                        "--K0 1 --duration 1 --out {}/relaxation.csv --plot {}/relaxation.png",
+                        d, d),
             "SI figure: stress relaxation after cessation (hermes2016, phi = 0.52)");
   r.figures.push_back(d + "/relaxation.png");
   // Claim: DST rate exists for phi_c <= phi <= phi_j (hermes2016), none below phi_c.
@@ -97,19 +102,20 @@ void steady(Reproduction& r) {
 
 void verification(Reproduction& r) {
   const std::string t = r.threads > 0 ? fmt::format(" --threads {}", r.threads) : "";
-  r.oobleck(fmt::format("run {}/scenes/verification/settling.toml --out {}/settling --quiet{}", OOBLECK_SOURCE_DIR, r.out, t),
-            "V4 settling");
+  r.oobleck(
+      fmt::format("run {}/scenes/verification/settling.toml --out {}/settling --quiet{}", OOBLECK_SOURCE_DIR, r.out, t),
+      "V4 settling");
   auto s = r.summary("settling");
   const double us = s["settling_velocity"], ua = s["settling_velocity_analytic"];
-  r.claims.push_back({"V4 settling velocity [m/s]", fmt::format("{:.4g} (drag-buoyancy balance)", ua), fmt::format("{:.4g}", us),
-                      single_verdict(std::fabs(us - ua) < 0.01 * ua, "more than 1 % off")});
-  r.oobleck(fmt::format("run {}/scenes/verification/couette_axisym.toml --out {}/couette --quiet{}{}", OOBLECK_SOURCE_DIR,
-                        r.out, t, r.quick ? " --set grid.cell_size=0.001" : ""),
+  r.claims.push_back({"V4 settling velocity [m/s]", fmt::format("{:.4g} (drag-buoyancy balance)", ua),
+                      fmt::format("{:.4g}", us), single_verdict(std::fabs(us - ua) < 0.01 * ua, "more than 1 % off")});
+  r.oobleck(fmt::format("run {}/scenes/verification/couette_axisym.toml --out {}/couette --quiet{}{}",
+                        OOBLECK_SOURCE_DIR, r.out, t, r.quick ? " --set grid.cell_size=0.001" : ""),
             "V3 Taylor-Couette");
   s = r.summary("couette");
   const double M = s["torque_analytic"], Mi = s["torque_inner"], Mo = s["torque_outer"];
-  r.claims.push_back({"V3 torque inner/outer [N m]", fmt::format("{:.4g} (4 pi eta B H)", M), fmt::format("{:.4g} / {:.4g}", Mi, Mo),
-                      [&] {
+  r.claims.push_back({"V3 torque inner/outer [N m]", fmt::format("{:.4g} (4 pi eta B H)", M),
+                      fmt::format("{:.4g} / {:.4g}", Mi, Mo), [&] {
                         const double off = std::max(std::fabs(Mi - M), std::fabs(Mo - M)) / M;
                         return off < 0.01   ? std::string("met (within 1 %)")
                                : off < 0.03 ? std::string("met within 3 % (coarse grid)")
@@ -157,19 +163,21 @@ void annular(Reproduction& r) {
   const double farthest = s.contains("front_farthest") ? s["front_farthest"].get<double>() : NAN;
   const double farthest_t = s.contains("front_farthest_time") ? s["front_farthest_time"].get<double>() : NAN;
   const double r_wall = pr.back();
-  r.claims.push_back({"S1 fast bob: a band grows from the bob at a near-constant front speed (paper)",
-                      "front at near-constant speed",
-                      fmt::format("velocity front (v_theta/(omega_bob r) = 0.5) at {:.3g} m/s, R^2 {:.3f} (front_speed, "
-                                  "front_fit), up to r = {:.1f} mm at {:.3f} s (front_farthest); outer wall at {:.1f} mm",
-                                  s["front_speed"].is_null() ? NAN : s["front_speed"].get<double>(), front_r2,
-                                  1e3 * farthest, farthest_t, 1e3 * r_wall),
-                      single_verdict(front_r2 >= 0.95, fmt::format("straight-line fit R^2 {:.3f} < 0.95", front_r2))});
-  r.claims.push_back({"S1 fast bob: the band rotates rigidly with the bob (paper)", "rigid band (v_theta/(omega_bob r) = 1)",
+  r.claims.push_back(
+      {"S1 fast bob: a band grows from the bob at a near-constant front speed (paper)", "front at near-constant speed",
+       fmt::format("velocity front (v_theta/(omega_bob r) = 0.5) at {:.3g} m/s, R^2 {:.3f} (front_speed, "
+                   "front_fit), up to r = {:.1f} mm at {:.3f} s (front_farthest); outer wall at {:.1f} mm",
+                   s["front_speed"].is_null() ? NAN : s["front_speed"].get<double>(), front_r2, 1e3 * farthest,
+                   farthest_t, 1e3 * r_wall),
+       single_verdict(front_r2 >= 0.95, fmt::format("straight-line fit R^2 {:.3f} < 0.95", front_r2))});
+  r.claims.push_back({"S1 fast bob: the band rotates rigidly with the bob (paper)",
+                      "rigid band (v_theta/(omega_bob r) = 1)",
                       fmt::format("at {:.2f} rad (profiles): v_theta/(omega_bob r) {:.2f} one cell from the bob, "
                                   "{:.2f} on average over the band (to its front at r = {:.1f} mm); max v/u_i {:.2f}",
                                   prof31["angle"].get<double>(), next_to_bob, band_mean, 1e3 * band_front, vmax),
-                      single_verdict(band_mean >= 0.9, "the band co-rotates but is not rigid (mean v_theta/(omega_bob r) "
-                                                       "over the band < 0.9)")});
+                      single_verdict(band_mean >= 0.9,
+                                     "the band co-rotates but is not rigid (mean v_theta/(omega_bob r) "
+                                     "over the band < 0.9)")});
   // "All flow stops when it reaches the outer wall": the velocity band at the wall
   // (flow_stop_time), and the outer half's rotation after its peak (outer_arrest).
   const auto& arrest = s["outer_arrest"];
@@ -178,32 +186,34 @@ void annular(Reproduction& r) {
   const bool band_at_wall = s["flow_stop_time"].is_number();
   const bool stops = band_at_wall && arrested && arrest["time"].get<double>() >= s["flow_stop_time"].get<double>() &&
                      arrest["final"].get<double>() < 0.1 * arrest["peak"].get<double>();
-  r.claims.push_back({"S1 fast bob: flow stops when the band reaches the outer wall (paper)", "all flow stops",
-                      fmt::format("velocity band at the outer wall {} (flow_stop_time); outer half's rotation / "
-                                  "omega_bob (outer_arrest): peak {:.2f} at {:.3f} s, below 10% of it {}, {:.2f} at the "
-                                  "end; last profile's distance from A r + B/r {:.2f}",
-                                  band_at_wall ? fmt::format("at {:.3f} s", s["flow_stop_time"].get<double>())
-                                               : std::string("never"),
-                                  arrest["peak"].get<double>(), arrest["peak_time"].get<double>(),
-                                  arrested ? fmt::format("from {:.3f} s", arrest["time"].get<double>()) : std::string("never"),
-                                  arrest["final"].get<double>(), last_dist),
-                      single_verdict(stops, band_at_wall ? "the band reaches the outer wall but the outer half keeps turning"
-                                                         : "the velocity band never reaches the outer wall; the "
-                                                           "co-rotation fades and the gap keeps shearing")});
+  r.claims.push_back(
+      {"S1 fast bob: flow stops when the band reaches the outer wall (paper)", "all flow stops",
+       fmt::format("velocity band at the outer wall {} (flow_stop_time); outer half's rotation / "
+                   "omega_bob (outer_arrest): peak {:.2f} at {:.3f} s, below 10% of it {}, {:.2f} at the "
+                   "end; last profile's distance from A r + B/r {:.2f}",
+                   band_at_wall ? fmt::format("at {:.3f} s", s["flow_stop_time"].get<double>()) : std::string("never"),
+                   arrest["peak"].get<double>(), arrest["peak_time"].get<double>(),
+                   arrested ? fmt::format("from {:.3f} s", arrest["time"].get<double>()) : std::string("never"),
+                   arrest["final"].get<double>(), last_dist),
+       single_verdict(stops, band_at_wall ? "the band reaches the outer wall but the outer half keeps turning"
+                                          : "the velocity band never reaches the outer wall; the "
+                                            "co-rotation fades and the gap keeps shearing")});
   // The project's own measure, not a claim of the paper: how far the jammed structure spreads.
   const bool spans = s.contains("structure_front_wall_time") && s["structure_front_wall_time"].is_number();
-  r.claims.push_back({"S1 fast bob: jammed structure (f >= f_m/2) reaches the outer wall (oobleck's own criterion, "
-                      "not the paper's)",
-                      "(none: the paper shows velocities only)",
-                      fmt::format("structure front at the outer wall {} (structure_front_wall_time)",
-                                  spans ? fmt::format("at {:.3f} s", s["structure_front_wall_time"].get<double>())
-                                        : std::string("never")),
-                      single_verdict(spans, "the structure front stays inside the gap")});
+  r.claims.push_back(
+      {"S1 fast bob: jammed structure (f >= f_m/2) reaches the outer wall (oobleck's own criterion, "
+       "not the paper's)",
+       "(none: the paper shows velocities only)",
+       fmt::format(
+           "structure front at the outer wall {} (structure_front_wall_time)",
+           spans ? fmt::format("at {:.3f} s", s["structure_front_wall_time"].get<double>()) : std::string("never")),
+       single_verdict(spans, "the structure front stays inside the gap")});
   // Slow bob: 0.31 rad of rotation takes 4.6 s at 0.84 mm/s; --quick: 2 mm grid up to 0.1 rad.
   const std::string qs = r.quick ? " --set grid.cell_size=0.002 --set duration=1.55" : " --set duration=4.7";
-  r.oobleck(fmt::format("run {}/scenes/paper/annular_shear.toml --out {}/annular_slow --quiet --set u_inner=0.00084{}{}",
-                        OOBLECK_SOURCE_DIR, r.out, t, qs),
-            "S1 annular shear, u_i = 0.84 mm/s (Fig. 6)");
+  r.oobleck(
+      fmt::format("run {}/scenes/paper/annular_shear.toml --out {}/annular_slow --quiet --set u_inner=0.00084{}{}",
+                  OOBLECK_SOURCE_DIR, r.out, t, qs),
+      "S1 annular shear, u_i = 0.84 mm/s (Fig. 6)");
   r.plot("plot_annular.py", {r.out + "/annular_slow", r.out + "/annular_slow.png"});
   const auto slow = r.summary("annular_slow");
   std::string dists;
@@ -227,7 +237,8 @@ void annular(Reproduction& r) {
     return j["steady_flow_possible"].get<bool>() ? "a steady flow exists" : "no steady flow";
   };
   auto mm = [](const nlohmann::json& j, const char* key) {
-    return j.contains(key) && j[key].is_number() ? fmt::format("{:.2f}", 1e3 * j[key].get<double>()) : std::string("n/a");
+    return j.contains(key) && j[key].is_number() ? fmt::format("{:.2f}", 1e3 * j[key].get<double>())
+                                                 : std::string("n/a");
   };
   r.claims.push_back(
       {"S1: steady 1D Couette flow at the bed's uniform phi (model calculation, undrained times)",
@@ -269,18 +280,22 @@ void intrusion(Reproduction& r) {
   };
   {
     const auto s9 = r.summary("intrusion_fig9");
-    r.claims.push_back({"S3 Fig. 9 run (phi 0.47, v0 0.175 m/s): k_l/k_t of the u_z = 0.5 v0 front (fit R² long./trans.)",
-                        "≈ 2 (Han et al. 2016)", ratio_with_r2(s9), single_verdict(in_range(s9), "outside [1.5, 2.5], or a front recedes")});
+    r.claims.push_back(
+        {"S3 Fig. 9 run (phi 0.47, v0 0.175 m/s): k_l/k_t of the u_z = 0.5 v0 front (fit R² long./trans.)",
+         "≈ 2 (Han et al. 2016)", ratio_with_r2(s9),
+         single_verdict(in_range(s9), "outside [1.5, 2.5], or a front recedes")});
   }
-  const std::vector<double> phis = r.quick ? std::vector<double>{0.46, 0.50} : std::vector<double>{0.46, 0.47, 0.48, 0.49, 0.50};
+  const std::vector<double> phis =
+      r.quick ? std::vector<double>{0.46, 0.50} : std::vector<double>{0.46, 0.47, 0.48, 0.49, 0.50};
   std::vector<std::string> runs;
   std::vector<RunOutcome> outcomes;
   std::string measured;
   for (double v0 : {0.2, 0.5}) {
     for (double phi : phis) {
       const std::string name = fmt::format("intrusion_phi{:.2f}_v{:.1f}", phi, v0);
-      r.oobleck(fmt::format("run {} --out {}/{} --quiet --set phi={} --set v0={}{}{}", scene, r.out, name, phi, v0, t, q),
-                fmt::format("S3 intrusion, phi = {}, v0 = {} m/s (Fig. 10)", phi, v0));
+      r.oobleck(
+          fmt::format("run {} --out {}/{} --quiet --set phi={} --set v0={}{}{}", scene, r.out, name, phi, v0, t, q),
+          fmt::format("S3 intrusion, phi = {}, v0 = {} m/s (Fig. 10)", phi, v0));
       runs.push_back(r.out + "/" + name);
       const auto s = r.summary(name);
       outcomes.push_back({fmt::format("phi {}, v0 {}", phi, v0), in_range(s)});
@@ -291,8 +306,9 @@ void intrusion(Reproduction& r) {
   args.insert(args.end(), runs.begin(), runs.end());
   run_tool("plot_intrusion.py", args);
   r.figures.push_back(r.out + "/intrusion_factors.png");
-  r.claims.push_back({"S3 k_l/k_t of the u_z = 0.5 v0 front, phi/v0 (fit R² long./trans.)", "≈ 2 for every phi, v0 (Han et al. 2016)",
-                      measured, subset_verdict(outcomes, "with k_l/k_t in [1.5, 2.5] (advancing fronts)")});
+  r.claims.push_back({"S3 k_l/k_t of the u_z = 0.5 v0 front, phi/v0 (fit R² long./trans.)",
+                      "≈ 2 for every phi, v0 (Han et al. 2016)", measured,
+                      subset_verdict(outcomes, "with k_l/k_t in [1.5, 2.5] (advancing fronts)")});
 }
 
 void rod(Reproduction& r) {
@@ -300,16 +316,18 @@ void rod(Reproduction& r) {
   // Fig. 8 (large container, eta_0 = 1 mPa s, several v0); --quick: 5 mm grids, 20 ms.
   const std::string t = r.threads > 0 ? fmt::format(" --threads {}", r.threads) : "";
   const std::string scene = std::string(OOBLECK_SOURCE_DIR) + "/scenes/paper/rod_impact.toml";
-  const std::string q = r.quick ? " --set cell_size=0.005 --set duration=0.02 --set analysis.snapshot_times=[0.02]" : "";
-  r.oobleck(fmt::format("run {} --out {}/rod_fig7 --quiet{}{}", scene, r.out, t, q), "S2 rod impact, v0 = 1 m/s (Fig. 7)");
+  const std::string q =
+      r.quick ? " --set cell_size=0.005 --set duration=0.02 --set analysis.snapshot_times=[0.02]" : "";
+  r.oobleck(fmt::format("run {} --out {}/rod_fig7 --quiet{}{}", scene, r.out, t, q),
+            "S2 rod impact, v0 = 1 m/s (Fig. 7)");
   r.plot("plot_rod.py", {r.out + "/rod_fig7", r.out + "/rod_fig7.png"});
   const auto s7 = r.summary("rod_fig7");
   const auto& prof = s7["displacement_below_rod"];
   r.claims.push_back({"S2 |dz| vs depth below the rod", "roughly linear at 60 ms (growing solid plug)",
-                      prof.contains("fit") ? fmt::format("slope {:.3f}, R² {:.3f} at t = {:.3g} s",
-                                                         prof["fit"]["slope"].get<double>(),
-                                                         prof["fit"]["r_squared"].get<double>(), prof["time"].get<double>())
-                                           : "n/a",
+                      prof.contains("fit")
+                          ? fmt::format("slope {:.3f}, R² {:.3f} at t = {:.3g} s", prof["fit"]["slope"].get<double>(),
+                                        prof["fit"]["r_squared"].get<double>(), prof["time"].get<double>())
+                          : "n/a",
                       single_verdict(prof.contains("fit") && prof["fit"]["r_squared"].get<double>() > 0.9,
                                      "not linear (R² <= 0.9) or no fit")});
   const std::string large = std::string(OOBLECK_SOURCE_DIR) + "/scenes/paper/rod_impact_large.toml";
@@ -324,7 +342,8 @@ void rod(Reproduction& r) {
     runs.push_back(r.out + "/" + name);
     const auto s = r.summary(name);
     const double peak = s["peak_deceleration_from_force"]["peak_deceleration"].get<double>();
-    outcomes.push_back({fmt::format("v0 {}", v0), peak > 10 * 9.81 && std::fabs(s["final_velocity"].get<double>()) < 0.5 * v0});
+    outcomes.push_back(
+        {fmt::format("v0 {}", v0), peak > 10 * 9.81 && std::fabs(s["final_velocity"].get<double>()) < 0.5 * v0});
     measured += fmt::format("v0 {}: peak {:.0f} m/s² at {:.2g} ms, final v {:.2f} m/s; ", v0,
                             s["peak_deceleration_from_force"]["peak_deceleration"].get<double>(),
                             1e3 * s["peak_deceleration_from_force"]["peak_deceleration_time"].get<double>(),
@@ -359,13 +378,13 @@ void wheel(Reproduction& r) {
                        j["hub_height_min"].get<double>(), j["bed_surface"].get<double>(), j["distance"].get<double>(),
                        j["duration"].get<double>());
   };
-  r.claims.push_back({"S4 wheel at omega = 10 rad/s", "runs along the surface (hub loss < 1 radius, travels forward)",
-                      line(s[0]),
-                      single_verdict(s[0]["stays_at_surface"].get<bool>(),
-                                     fmt::format("the hub loses {:.3f} m, more than one radius ({:.3f} m), or does not "
-                                                 "travel forward (the scene's grid and transfer; docs/results.md has "
-                                                 "the refinement study)",
-                                                 s[0]["height_loss"].get<double>(), s[0]["wheel_radius"].get<double>()))});
+  r.claims.push_back(
+      {"S4 wheel at omega = 10 rad/s", "runs along the surface (hub loss < 1 radius, travels forward)", line(s[0]),
+       single_verdict(s[0]["stays_at_surface"].get<bool>(),
+                      fmt::format("the hub loses {:.3f} m, more than one radius ({:.3f} m), or does not "
+                                  "travel forward (the scene's grid and transfer; docs/results.md has "
+                                  "the refinement study)",
+                                  s[0]["height_loss"].get<double>(), s[0]["wheel_radius"].get<double>()))});
   r.claims.push_back({"S4 wheel at omega = 1 rad/s", "sinks (hub below the initial bed surface)", line(s[1]),
                       single_verdict(s[1]["sinks"].get<bool>(), "the hub ends above the bed surface")});
   const double dh = s[0]["hub_height_final"].get<double>() - s[1]["hub_height_final"].get<double>();
@@ -408,13 +427,15 @@ void wheel(Reproduction& r) {
   r.claims.push_back({"SI: pressure under the wheel vs granular stiffness (G, K x 1 / 10 / 100, dt the same)",
                       "the stress field's quality degrades as G and K increase (ringing)",
                       fmt::format("within-cell scatter of p~ under the wheel, pooled over frames to 1 s "
-                                  "(docs/analysis.md): {}", fmt::join(measured, "; ")),
+                                  "(docs/analysis.md): {}",
+                                  fmt::join(measured, "; ")),
                       single_verdict(degrades, "the scatter does not grow with the stiffness")});
 }
 
 void write_report(const Reproduction& r, double seconds) {
   std::string md = "# oobleck reproduce — measured claims vs the paper\n\n";
-  md += fmt::format("Mode: {}. Wall time: {:.0f} s. Commands and their output: `log.txt`.\n\n", r.quick ? "--quick" : "full", seconds);
+  md += fmt::format("Mode: {}. Wall time: {:.0f} s. Commands and their output: `log.txt`.\n\n",
+                    r.quick ? "--quick" : "full", seconds);
   md += "| claim | paper / reference | measured | verdict |\n|---|---|---|---|\n";
   for (const auto& c : r.claims) md += fmt::format("| {} | {} | {} | {} |\n", c[0], c[1], c[2], c[3]);
   md += "\n## Figures\n\n";

@@ -17,7 +17,6 @@
 namespace oobleck::cli {
 namespace {
 
-
 void flow_curve_command(CLI::App& rheology) {
   auto* cmd = rheology.add_subcommand("flow-curve", "steady flow curves tau(gamma_dot) with every branch (E11)");
   struct Opts {
@@ -52,8 +51,8 @@ void flow_curve_command(CLI::App& rheology) {
       }
     }
     csv.commit();
-    fmt::print("wrote {} ({} curves x {} points; parameters {} [{} units])\n", o->out, o->phi.size(), o->points,
-               p.name, p.units);
+    fmt::print("wrote {} ({} curves x {} points; parameters {} [{} units])\n", o->out, o->phi.size(), o->points, p.name,
+               p.units);
     if (!o->png.empty()) {
       std::vector<std::string> args = {o->out, "--title", fmt::format("{} ({} units)", p.name, p.units)};
       if (p.units == "normalized") args.emplace_back("--normalized");
@@ -101,9 +100,10 @@ void dst_command(CLI::App& rheology) {
     if (!fastest) {
       fmt::print("fastest steady shear: unbounded (the flow curve rises without limit)\n");
     } else if (fastest->attained) {
-      fmt::print("fastest steady shear = {:.6g} 1/s at tau = {:.4g} Pa (the flow curve's peak); no steady flow is "
-                 "faster\n",
-                 fastest->shear_rate, fastest->shear_stress);
+      fmt::print(
+          "fastest steady shear = {:.6g} 1/s at tau = {:.4g} Pa (the flow curve's peak); no steady flow is "
+          "faster\n",
+          fastest->shear_rate, fastest->shear_stress);
     } else {
       fmt::print("fastest steady shear = gamma_dot_DST, approached as the stress diverges; no steady flow is faster\n");
     }
@@ -133,7 +133,7 @@ void structure_command(CLI::App& rheology) {
     const double ts = p.steady.tau_star;
     for (int k = 0; k < o->points; ++k) {
       const double tau = ts * std::pow(10.0, -3.0 + 6.0 * k / (o->points - 1));
-      const double H = rheology::hardening(tau, ts);       // E7 with tau_bar ~ tau
+      const double H = rheology::hardening(tau, ts);           // E7 with tau_bar ~ tau
       const double f_model = rheology::steady_f(H, 1.0, 1.0);  // E10, S = 1 (eta_B -> inf), f_m = 1
       csv.stream() << fmt::format("{},{},{},{}\n", num(tau), num(f_model), num(1.0 - std::exp(-tau / ts)),
                                   num(std::exp(-ts / tau)));

@@ -43,8 +43,10 @@ void add_run_command(CLI::App& app) {
         throw InputError("--restart DIR continues the stored scene of DIR: give no scene file and no --set");
       }
       if (!std::filesystem::exists(run::checkpoint_path(o->restart))) {
-        throw InputError(fmt::format("--restart {}: no checkpoint there ({} is missing); run with "
-                                     "--checkpoint-every N to write one", o->restart, run::checkpoint_path(o->restart)));
+        throw InputError(
+            fmt::format("--restart {}: no checkpoint there ({} is missing); run with "
+                        "--checkpoint-every N to write one",
+                        o->restart, run::checkpoint_path(o->restart)));
       }
       cfg = scene::load_scene(run::stored_scene_path(o->restart));
       ro.out_dir = o->restart;

@@ -15,8 +15,8 @@ static void BM_FlowCurve(benchmark::State& state, const char* preset, double phi
     auto c = rheology::flow_curve(p.steady, phi, n);
     benchmark::DoNotOptimize(c.data());
   }
-  state.counters["points/s"] = benchmark::Counter(static_cast<double>(n) * static_cast<double>(state.iterations()),
-                                                  benchmark::Counter::kIsRate);
+  state.counters["points/s"] =
+      benchmark::Counter(static_cast<double>(n) * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 
 BENCHMARK_CAPTURE(BM_FlowCurve, hermes2016_dst, "hermes2016", 0.47, 0.0)->Arg(400);

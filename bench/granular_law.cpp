@@ -197,7 +197,9 @@ std::vector<Case> make_loose_bed(const LooseBed& b, int n) {
   std::mt19937_64 rng(2024);
   std::uniform_real_distribution<double> U(0.0, 1.0);
   std::normal_distribution<double> N(0.0, 1.0);
-  auto log_uniform = [&](double lo, double hi) { return std::exp(std::log(lo) + (std::log(hi) - std::log(lo)) * U(rng)); };
+  auto log_uniform = [&](double lo, double hi) {
+    return std::exp(std::log(lo) + (std::log(hi) - std::log(lo)) * U(rng));
+  };
   auto random_sym = [&] {
     Eigen::Matrix3d m;
     for (int i = 0; i < 3; ++i)

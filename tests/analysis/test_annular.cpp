@@ -34,9 +34,7 @@ GridField2D grid() {
   return f;
 }
 
-double newtonian(double r) {
-  return kUi * kR0 * (kRo * kRo / r - r) / (kRo * kRo - kR0 * kR0);
-}
+double newtonian(double r) { return kUi * kR0 * (kRo * kRo / r - r) / (kRo * kRo - kR0 * kR0); }
 
 // Rigid rotation out to r_f, then v/(omega r) falls linearly (width 4 mm) through 0.5 at r_f.
 ShearFrame band_frame(double t, double r_front) {
@@ -140,8 +138,7 @@ TEST(AnnularShear, FlowStopsWhenTheGapComesToRest) {
     fr.v_theta = grid();
     for (std::size_t j = 0; j < fr.v_theta.ny; ++j) {
       fr.v_theta.at(0, j) = kUi;  // the bob keeps its prescribed speed
-      for (std::size_t i = 1; i < fr.v_theta.nx; ++i)
-        fr.v_theta.at(i, j) = k < 3 ? newtonian(fr.v_theta.x(i)) : 1e-9;
+      for (std::size_t i = 1; i < fr.v_theta.nx; ++i) fr.v_theta.at(i, j) = k < 3 ? newtonian(fr.v_theta.x(i)) : 1e-9;
     }
     frames.push_back(fr);
   }
@@ -150,8 +147,8 @@ TEST(AnnularShear, FlowStopsWhenTheGapComesToRest) {
   EXPECT_NEAR(*stop.time_s, 0.3, 1e-12);
   EXPECT_TRUE(stop.by_velocity);
   EXPECT_FALSE(stop.by_front);
-  EXPECT_FALSE(flow_stop_time(std::vector<ShearFrame>(frames.begin(), frames.begin() + 3), geometry(), 1e-6)
-                   .time_s.has_value());
+  EXPECT_FALSE(
+      flow_stop_time(std::vector<ShearFrame>(frames.begin(), frames.begin() + 3), geometry(), 1e-6).time_s.has_value());
 }
 
 TEST(AnnularShear, OuterHalfRotationAndItsArrest) {
@@ -208,7 +205,7 @@ TEST(AnnularShear, StructureFrontFollowsTheSpreadOfF) {
   }
   const auto t_wall = front_at_wall_time(fronts, g, 1e-3);
   ASSERT_TRUE(t_wall.has_value());
-  EXPECT_NEAR(*t_wall, 1.1, 1e-12);  // the first frame at or after 1.0667 s
+  EXPECT_NEAR(*t_wall, 1.1, 1e-12);    // the first frame at or after 1.0667 s
   EXPECT_TRUE(fronts.back().at_wall);  // r_s = 54.5 mm: f >= 0.15 everywhere in the gap
   EXPECT_FALSE(front_at_wall_time(std::vector<ShearFront>(fronts.begin(), fronts.begin() + 10), g, 1e-3).has_value());
   // The velocity front of the same frames stays where band_frame put it: the two are independent.
@@ -270,7 +267,8 @@ TEST(AnnularShear, SteadyCouetteLimitMatchesClosedForms) {
     rate.push_back(gm * t / tp * std::exp(1.0 - t / tp));
   }
   const double t_star = tp * std::log(1.0 / k) / (1.0 - k);
-  const double u_star = 0.5 * std::exp(1.0) * gm * (std::exp(-k * t_star / tp) - std::exp(-t_star / tp)) * g.bob_radius_m;
+  const double u_star =
+      0.5 * std::exp(1.0) * gm * (std::exp(-k * t_star / tp) - std::exp(-t_star / tp)) * g.bob_radius_m;
   const auto c = steady_couette_limit(tau, rate, g);
   EXPECT_NEAR(c.bob_speed_m_per_s, u_star, 1e-6 * u_star);
   EXPECT_NEAR(c.bob_stress_Pa, t_star, 2e-3 * t_star);

@@ -13,11 +13,11 @@ using oobleck::InputError;
 
 namespace {
 
-constexpr double kH = 1e-3;          // cell size [m]
-constexpr double kSurface = 0.030;   // bed surface = tip z at t = 0 [m]
-constexpr double kRadius = 0.005;    // intruder radius [m]
-constexpr double kV0 = -0.2;         // intruder velocity along z (downward) [m/s]
-constexpr double kRamp = 4e-3;       // width of the linear ramp of u_z/v_0 across a front [m]
+constexpr double kH = 1e-3;         // cell size [m]
+constexpr double kSurface = 0.030;  // bed surface = tip z at t = 0 [m]
+constexpr double kRadius = 0.005;   // intruder radius [m]
+constexpr double kV0 = -0.2;        // intruder velocity along z (downward) [m/s]
+constexpr double kRamp = 4e-3;      // width of the linear ramp of u_z/v_0 across a front [m]
 
 double ramp(double s, double s_front) { return std::clamp(0.5 - (s - s_front) / kRamp, 0.0, 1.0); }
 
@@ -32,7 +32,7 @@ GridField2D empty_grid() {
 }
 
 struct Synthetic {
-  double k_l, k_t;      // propagation factors of the synthetic fronts
+  double k_l, k_t;       // propagation factors of the synthetic fronts
   double ahead0 = 3e-3;  // front ahead of the tip at t = 0 [m]
   double edge0 = 3e-3;   // transverse front beyond the edge at t = 0 [m]
   bool tanh_profile = false;
@@ -181,8 +181,8 @@ TEST(IntrusionFronts, TipGapSkipsEmptyNodesInsideTheIntruder) {
   const FrontPosition at_tip = measure_front(fr.field, fr.tip_z_m, velocity_front(kV0), g);
   EXPECT_FALSE(at_tip.longitudinal_found);  // 0.3 x 1 + 0.7 x 0 interpolated at the tip
   EXPECT_FALSE(at_tip.transverse_found);    // same at r = R on the tip-depth line
-  g.tip_gap_m = 0.5e-3;           // longitudinal search from 29.2 mm
-  g.transverse_offset_m = 0.5e-3;  // transverse line at 29.2 mm
+  g.tip_gap_m = 0.5e-3;                     // longitudinal search from 29.2 mm
+  g.transverse_offset_m = 0.5e-3;           // transverse line at 29.2 mm
   const FrontPosition gap = measure_front(fr.field, fr.tip_z_m, velocity_front(kV0), g);
   ASSERT_TRUE(gap.longitudinal_found);
   EXPECT_NEAR(gap.longitudinal_ahead_m, syn.ahead(0.0015), 0.01 * kH);
@@ -211,7 +211,8 @@ TEST(IntrusionFronts, TimeFilterIsACenteredMovingAverage) {
   std::vector<IntrusionFrame> frames = syn.run(0.004, 1e-3);
   // Replace the fields by a field linear in time: the centered average reproduces it inside.
   for (IntrusionFrame& f : frames)
-    for (std::size_t n = 0; n < f.field.values.size(); ++n) f.field.values[n] = 1.0 + 100.0 * f.time_s + 1e-3 * static_cast<double>(n);
+    for (std::size_t n = 0; n < f.field.values.size(); ++n)
+      f.field.values[n] = 1.0 + 100.0 * f.time_s + 1e-3 * static_cast<double>(n);
   const std::vector<IntrusionFrame> out = time_filter(frames, 3);
   ASSERT_EQ(out.size(), frames.size());
   for (std::size_t k = 1; k + 1 < out.size(); ++k)
@@ -291,8 +292,7 @@ TEST(IntrusionFronts, FilterOverOneRingingPeriodRemovesIt) {
   const FrontSpeeds raw = front_speeds(measure_front_series(frames, velocity_front(kV0), geometry()), kV0, o);
   EXPECT_GT(raw.k_l_stderr, 1e-3);
   EXPECT_GT(raw.ratio_stderr, 1e-3);
-  const FrontSpeeds filtered =
-      front_speeds(measure_front_series(frames, velocity_front(kV0), geometry(), 5), kV0, o);
+  const FrontSpeeds filtered = front_speeds(measure_front_series(frames, velocity_front(kV0), geometry(), 5), kV0, o);
   EXPECT_NEAR(filtered.k_l, 2.0, 1e-8);
   EXPECT_NEAR(filtered.k_t, 1.0, 1e-8);
   EXPECT_LT(filtered.ratio_stderr, 1e-6);

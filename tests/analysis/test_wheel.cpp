@@ -142,7 +142,8 @@ TEST(Wheel, PressureScatterOfALinearFieldIsItsGradientAcrossACell) {
   // ±gx h/4 ± gy h/4, so the rms deviation is (h/4) sqrt(gx² + gy²) whatever p0.
   const double h = 0.1, gx = 300.0, gy = -500.0;
   std::vector<double> x, y, p;
-  cell_points(20, 10, h, [&](double px, double py, int) { return 4000.0 + gx * px + gy * py; }, x, y, p);
+  cell_points(
+      20, 10, h, [&](double px, double py, int) { return 4000.0 + gx * px + gy * py; }, x, y, p);
   const ScatterWindow w = window(1.0, 1.0, 1.0, h);
   const PressureScatter s = pressure_scatter(x, y, p, w);
   EXPECT_EQ(s.points, 800);
@@ -159,8 +160,8 @@ TEST(Wheel, PressureScatterOfPointToPointNoiseIsItsAmplitude) {
   // means p0 — rms deviation eps p0, relative scatter eps / sqrt(1 + eps²).
   const double h = 0.05, p0 = 2500.0, eps = 0.3;
   std::vector<double> x, y, p;
-  cell_points(8, 6, h, [&](double, double, int sub) { return p0 * (1.0 + ((sub == 0 || sub == 3) ? eps : -eps)); },
-              x, y, p);
+  cell_points(
+      8, 6, h, [&](double, double, int sub) { return p0 * (1.0 + ((sub == 0 || sub == 3) ? eps : -eps)); }, x, y, p);
   const ScatterWindow w = window(0.2, 0.2, 0.3, h);
   const PressureScatter s = pressure_scatter(x, y, p, w);
   EXPECT_NEAR(s.rms_deviation_Pa, eps * p0, 1e-9);
@@ -172,7 +173,8 @@ TEST(Wheel, PressureScatterWindowWrapsAroundThePeriodicTrack) {
   // seam: columns 18, 19, 0, 1 of 10 rows, 4 points each. A point alone in its cell is left out.
   const double h = 0.1;
   std::vector<double> x, y, p;
-  cell_points(20, 10, h, [](double px, double, int) { return px < 0.4 || px > 1.8 ? 100.0 : 1e6; }, x, y, p);
+  cell_points(
+      20, 10, h, [](double px, double, int) { return px < 0.4 || px > 1.8 ? 100.0 : 1e6; }, x, y, p);
   x.push_back(0.02);  // outside the grid rows above: its own cell (row 10)
   y.push_back(1.02);
   p.push_back(5e6);

@@ -41,7 +41,8 @@ constexpr const char* kLoader = "/lib64/ld-linux-x86-64.so.2";
 TEST(CpuVariants, VersionNamesTheLibraryThatRuns) {
   const auto r = clitest::run("--version");
   ASSERT_EQ(r.status, 0) << r.output;
-  EXPECT_TRUE(std::regex_search(r.output, std::regex(R"(^oobleck \d+\.\d+\.\d+ \(library: (x86-64(-v[234])?|other)(, -march=native)?\))")))
+  EXPECT_TRUE(std::regex_search(
+      r.output, std::regex(R"(^oobleck \d+\.\d+\.\d+ \(library: (x86-64(-v[234])?|other)(, -march=native)?\))")))
       << r.output;
 }
 
@@ -67,8 +68,8 @@ TEST(CpuVariants, BaselineLibraryRunsTheSceneOfTheBestVariantToRoundOff) {
   const std::string args = " --set time.duration=2e-5 --threads 1 --quiet --out ";
   const auto best = clitest::run("run " + scene + args + d / "best");
   ASSERT_EQ(best.status, 0) << best.output;
-  const auto base = clitest::run("run " + scene + args + d / "base",
-                                 std::string(kLoader) + " --glibc-hwcaps-mask baseline");
+  const auto base =
+      clitest::run("run " + scene + args + d / "base", std::string(kLoader) + " --glibc-hwcaps-mask baseline");
   ASSERT_EQ(base.status, 0) << base.output;
   EXPECT_EQ(summary(d / "best")["library_instruction_set"], expected);
   EXPECT_EQ(summary(d / "base")["library_instruction_set"], "x86-64");
@@ -76,8 +77,7 @@ TEST(CpuVariants, BaselineLibraryRunsTheSceneOfTheBestVariantToRoundOff) {
   ASSERT_EQ(a.size(), b.size());
   ASSERT_GT(a.size(), 10u);
   EXPECT_EQ(a[1], 20.0);  // step
-  for (std::size_t k = 0; k < a.size(); ++k)
-    EXPECT_NEAR(a[k], b[k], 1e-9 * std::abs(a[k]) + 1e-30) << "column " << k;
+  for (std::size_t k = 0; k < a.size(); ++k) EXPECT_NEAR(a[k], b[k], 1e-9 * std::abs(a[k]) + 1e-30) << "column " << k;
   EXPECT_GT(a[2], 0.0);  // the grains move: the comparison is not of zeros
 #endif
 }

@@ -24,7 +24,8 @@ class FitCli : public ::testing::Test {
  protected:
   void SetUp() override {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / (std::string("oobleck_fit_cli_") + info->name() + "_" + std::to_string(::getpid()));
+    dir_ =
+        fs::temp_directory_path() / (std::string("oobleck_fit_cli_") + info->name() + "_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -34,8 +35,8 @@ class FitCli : public ::testing::Test {
 
   /// Runs the CLI with `args`; stdout to out.txt, stderr to err.txt; returns the exit status.
   int run(const std::string& args) {
-    const std::string cmd = std::string(OOBLECK_CLI) + " " + args + " > '" + path("out.txt") + "' 2> '" +
-                            path("err.txt") + "'";
+    const std::string cmd =
+        std::string(OOBLECK_CLI) + " " + args + " > '" + path("out.txt") + "' 2> '" + path("err.txt") + "'";
     const int rc = std::system(cmd.c_str());
     return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
   }
@@ -65,8 +66,7 @@ class FitCli : public ::testing::Test {
 
 TEST_F(FitCli, SuccessWritesLoadableToml) {
   write("low.csv", low_csv());
-  ASSERT_EQ(run("rheology fit --kind low --data " + path("low.csv") + " --preset hermes2016 --out " +
-                path("fit.toml")),
+  ASSERT_EQ(run("rheology fit --kind low --data " + path("low.csv") + " --preset hermes2016 --out " + path("fit.toml")),
             0)
       << read("err.txt");
   ASSERT_TRUE(fs::exists(path("fit.toml")));
@@ -171,8 +171,8 @@ TEST_F(FitCli, DstFitWithPlot) {
            std::to_string(*oobleck::rheology::shear_rate_dst(p, phi) * (1.0 + 0.01 * std::sin(3.0 * k))) + "\n";
   }
   write("dst.csv", csv);
-  ASSERT_EQ(run("rheology fit --kind dst --data " + path("dst.csv") + " --preset dhaene1993 --out " +
-                path("fit.toml") + " --plot " + path("fit.png")),
+  ASSERT_EQ(run("rheology fit --kind dst --data " + path("dst.csv") + " --preset dhaene1993 --out " + path("fit.toml") +
+                " --plot " + path("fit.png")),
             0)
       << read("err.txt");
   EXPECT_TRUE(fs::exists(path("fit.png")));

@@ -18,8 +18,7 @@ TEST(ReproduceVerdict, ASubsetIsNotMetAndNamesTheSubset) {
   std::vector<RunOutcome> runs;
   for (const char* v : {"0.2", "0.5"})
     for (const char* phi : {"0.46", "0.47", "0.48", "0.49", "0.50"})
-      runs.push_back({std::string("phi ") + phi + ", v0 " + v,
-                      std::string(v) == "0.2" && std::string(phi) < "0.49"});
+      runs.push_back({std::string("phi ") + phi + ", v0 " + v, std::string(v) == "0.2" && std::string(phi) < "0.49"});
   EXPECT_EQ(subset_verdict(runs, "with k_l/k_t in [1.5, 2.5]"),
             "not met: 3 of 10 runs with k_l/k_t in [1.5, 2.5] (phi 0.46, v0 0.2; phi 0.47, v0 0.2; phi 0.48, v0 0.2)");
   // S2 Fig. 8: one launch speed of three.

@@ -28,8 +28,8 @@ TEST(RheologyCli, FlowCurveCsvHasContractColumnsAndOrderedRows) {
   std::ifstream in(d / "fc.csv");
   std::string header;
   std::getline(in, header);
-  for (const char* col : {"phi", "f", "shear_rate", "shear_stress", "granular_pressure", "granular_shear_stress",
-                          "viscosity"}) {
+  for (const char* col :
+       {"phi", "f", "shear_rate", "shear_stress", "granular_pressure", "granular_shear_stress", "viscosity"}) {
     EXPECT_NE(("," + header + ",").find(std::string(",") + col + ","), std::string::npos) << col;
   }
   int rows = 0;
@@ -63,8 +63,9 @@ TEST(RheologyCli, DstJsonShape) {
 }
 
 TEST(RheologyCli, VolumeFractionAndStructure) {
-  auto r = run("rheology volume-fraction --mass-fraction 0.4 --rho-cs 1000 --rho-liquid 1000 --rho-water 1000 "
-               "--lambda 0 --beta 0 --json");
+  auto r =
+      run("rheology volume-fraction --mass-fraction 0.4 --rho-cs 1000 --rho-liquid 1000 --rho-water 1000 "
+          "--lambda 0 --beta 0 --json");
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NEAR(nlohmann::json::parse(r.output)["phi"].get<double>(), 0.4, 1e-14);
   clitest::TempDir d;
@@ -84,8 +85,10 @@ TEST_P(BadInput, ClearMessageNonZeroExitNoOutput) {
   clitest::TempDir d;
   const std::string out = d / "out.csv";
   // A bad file used by several cases.
-  std::ofstream(d / "bad.toml") << "[steady]\nphi_c = 0.6\nphi_j = 0.5\na_0 = 1\na_inf = 1\ntau_star = 1\neta_0 = 1\nmu_c = 1\n";
-  std::ofstream(d / "neg.toml") << "[steady]\nphi_c = 0.4\nphi_j = 0.5\na_0 = 1\na_inf = 1\ntau_star = 1\neta_0 = -1\nmu_c = 1\n";
+  std::ofstream(d / "bad.toml")
+      << "[steady]\nphi_c = 0.6\nphi_j = 0.5\na_0 = 1\na_inf = 1\ntau_star = 1\neta_0 = 1\nmu_c = 1\n";
+  std::ofstream(d / "neg.toml")
+      << "[steady]\nphi_c = 0.4\nphi_j = 0.5\na_0 = 1\na_inf = 1\ntau_star = 1\neta_0 = -1\nmu_c = 1\n";
   std::ofstream(d / "miss.toml") << "[steady]\nphi_c = 0.4\nphi_j = 0.5\na_0 = 1\na_inf = 1\neta_0 = 1\nmu_c = 1\n";
   std::string args = GetParam().args;
   for (auto [key, val] : {std::pair<std::string, std::string>{"{OUT}", out}, {"{DIR}", d.path.string()}}) {

@@ -74,14 +74,15 @@ TEST(Checkpoint, RoundTripIsBitExact) {
   TempDir dir;
   const std::string path = dir.file("checkpoint.h5");
   const auto d = awkward_doubles();
-  const std::vector<std::int64_t> ints{0, -1, std::numeric_limits<std::int64_t>::min(),
-                                       std::numeric_limits<std::int64_t>::max(), 42, -7};
+  const std::vector<std::int64_t> ints{
+      0, -1, std::numeric_limits<std::int64_t>::min(), std::numeric_limits<std::int64_t>::max(), 42, -7};
   std::vector<std::uint8_t> bytes(256);
   for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = static_cast<std::uint8_t>(i);
   std::vector<double> matrix(12);
   for (std::size_t i = 0; i < matrix.size(); ++i) matrix[i] = std::sin(static_cast<double>(i) + 0.1);
   std::string config;
-  for (int i = 0; config.size() < 200000; ++i) config += "[material.grains]  # \xcf\x86 = 0.47, line " + std::to_string(i) + "\n";
+  for (int i = 0; config.size() < 200000; ++i)
+    config += "[material.grains]  # \xcf\x86 = 0.47, line " + std::to_string(i) + "\n";
   const double time = 1.0 / 7.0;
 
   {

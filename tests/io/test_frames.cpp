@@ -50,7 +50,8 @@ std::size_t count_of(const std::string& text, const std::string& what) {
 /// checks that do without h5py.
 int run_checker(const std::string& xmf, bool no_h5py = false) {
   if (!fs::exists("/usr/bin/python3")) return -1;
-  const std::string cmd = std::string(no_h5py ? "CHECK_XDMF_NO_H5PY=1 " : "") + "/usr/bin/python3 " + std::string(OOBLECK_SOURCE_DIR) + "/tools/check_xdmf.py --quiet '" + xmf + "'";
+  const std::string cmd = std::string(no_h5py ? "CHECK_XDMF_NO_H5PY=1 " : "") + "/usr/bin/python3 " +
+                          std::string(OOBLECK_SOURCE_DIR) + "/tools/check_xdmf.py --quiet '" + xmf + "'";
   const int status = std::system(cmd.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -2;
 }

@@ -19,12 +19,16 @@ class CiGuard {
     const char* old = std::getenv("CI");
     had_ = old != nullptr;
     if (had_) old_ = old;
-    if (value) ::setenv("CI", value, 1);
-    else ::unsetenv("CI");
+    if (value)
+      ::setenv("CI", value, 1);
+    else
+      ::unsetenv("CI");
   }
   ~CiGuard() {
-    if (had_) ::setenv("CI", old_.c_str(), 1);
-    else ::unsetenv("CI");
+    if (had_)
+      ::setenv("CI", old_.c_str(), 1);
+    else
+      ::unsetenv("CI");
   }
 
  private:

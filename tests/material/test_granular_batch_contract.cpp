@@ -62,8 +62,8 @@ void batch_equals_point_by_point(const std::string& preset_name, std::uint64_t s
   for (int k = 0; k < n; ++k) {
     phi[k] = loose ? 0.47 + 0.02 * U(rng) : 0.3 + 0.3 * U(rng);
     f[k] = loose ? (U(rng) < 0.2 ? 0.0 : log_uniform(rng, 1e-22, 1e-3)) : U(rng);
-    const double p = (U(rng) < (loose ? 0.5 : 0.2) ? -1.0 : 1.0) * (loose ? log_uniform(rng, 1e-12, 1e-2)
-                                                                          : log_uniform(rng, 1e-3, 1e6));
+    const double p = (U(rng) < (loose ? 0.5 : 0.2) ? -1.0 : 1.0) *
+                     (loose ? log_uniform(rng, 1e-12, 1e-2) : log_uniform(rng, 1e-3, 1e6));
     Eigen::Matrix3d s = random_tensor(rng, 1.0);
     s = 0.5 * (s + s.transpose()).eval();
     s.diagonal().array() -= s.trace() / 3.0;
@@ -151,7 +151,8 @@ void batch_equals_point_by_point(const std::string& preset_name, std::uint64_t s
   }
   // the batch must have met the regimes whose Newton solves it runs in lanes
   EXPECT_GT(counts[static_cast<int>(GranularRegime::kShear)], n / 20);
-  EXPECT_GT(counts[static_cast<int>(GranularRegime::kShearCompaction)] + counts[static_cast<int>(GranularRegime::kCompaction)],
+  EXPECT_GT(counts[static_cast<int>(GranularRegime::kShearCompaction)] +
+                counts[static_cast<int>(GranularRegime::kCompaction)],
             n / 20);
   if (!loose) {
     EXPECT_GT(counts[static_cast<int>(GranularRegime::kSeparated)], 5);

@@ -21,8 +21,8 @@ using LD = long double;
 struct Reference {
   LD G, K, K3, mu, d2rho, eta, phi, phim, a;
   LD p_tr, tau_tr, dt;
-  LD beta(LD Im) const { return K3 * (phi - phim / (1 + a * Im)); }             // E18
-  LD Q(LD g) const { return g * (g * d2rho + 2 * eta); }                        // I_m^2 p (E19)
+  LD beta(LD Im) const { return K3 * (phi - phim / (1 + a * Im)); }  // E18
+  LD Q(LD g) const { return g * (g * d2rho + 2 * eta); }             // I_m^2 p (E19)
   // pressure balance p = p_tr + K dt beta(I_m(g, p)) g: increasing in p, bisection on (0, S]
   LD p_of(LD g) const {
     const LD S = p_tr + K * dt * K3 * phi * g;
@@ -101,9 +101,18 @@ void sweep(double G, double K, double K_0, double eta_0, double phi, double dt, 
     ASSERT_EQ(u.structure_iterations, 0);
     (u.p_trial <= 0.0 ? tension : positive)++;
     const LD f = before.f;
-    const Reference ref{G, K, P.granular.K_3, law.mu_2(), LD(P.granular.d) * P.granular.d * P.granular.rho_s, eta_0,
-                        phi, P.steady.phi_j + (P.steady.phi_c - P.steady.phi_j) * f,
-                        P.steady.a_0 + (P.steady.a_inf - P.steady.a_0) * f, u.p_trial, u.tau_trial, dt};
+    const Reference ref{G,
+                        K,
+                        P.granular.K_3,
+                        law.mu_2(),
+                        LD(P.granular.d) * P.granular.d * P.granular.rho_s,
+                        eta_0,
+                        phi,
+                        P.steady.phi_j + (P.steady.phi_c - P.steady.phi_j) * f,
+                        P.steady.a_0 + (P.steady.a_inf - P.steady.a_0) * f,
+                        u.p_trial,
+                        u.tau_trial,
+                        dt};
     const LD g = ref.solve_g(), p = ref.p_of(g), tau = ref.friction(g, p);
     const bool ok = std::fabs(u.gamma_dot_p - g) <= 1e-10L * g && std::fabs(u.p - p) <= 1e-9L * p &&
                     std::fabs(u.tau_bar - tau) <= 1e-9L * tau;
@@ -113,8 +122,8 @@ void sweep(double G, double K, double K_0, double eta_0, double phi, double dt, 
     }
   }
   EXPECT_EQ(failures, 0);
-  EXPECT_GT(tension, 1000);     // the p_tr <= 0 path is what these states exercise
-  EXPECT_GT(compaction, 300);   // and the closed-form f_1 + f_3 regime
+  EXPECT_GT(tension, 1000);    // the p_tr <= 0 path is what these states exercise
+  EXPECT_GT(compaction, 300);  // and the closed-form f_1 + f_3 regime
   std::printf("shear with p_tr <= 0: %d, with p_tr > 0: %d, shear+compaction: %d\n", tension, positive, compaction);
 }
 

@@ -28,8 +28,9 @@ TEST(GranularRegimes, ElasticIncrementIsHypoelastic) {
   const auto u = law.update(st, D, W, dt, 0.53);  // phi_m(0.5) = 0.4855 < 0.53
   ASSERT_TRUE(u.ok());
   EXPECT_EQ(u.regime, GranularRegime::kElastic);
-  const Eigen::Matrix3d expected = before.sigma + dt * (2.0 * G * D + (K - 2.0 * G / 3.0) * D.trace() * Eigen::Matrix3d::Identity() +
-                                                        W * before.sigma - before.sigma * W);
+  const Eigen::Matrix3d expected =
+      before.sigma + dt * (2.0 * G * D + (K - 2.0 * G / 3.0) * D.trace() * Eigen::Matrix3d::Identity() +
+                           W * before.sigma - before.sigma * W);
   EXPECT_LT((st.sigma - expected).norm(), 1e-12 * expected.norm());
   // no flow: only the buckling term of E24 acts, f = f_n/(1 + dt K_0 tau_bar/eta_B) (linearly implicit)
   const double inv_eta_B = 1.86e4 * std::pow(0.535 - 0.53, 4.0) + 9.3e-3 * std::pow(0.535 - 0.53, 0.1);  // E8

@@ -101,10 +101,11 @@ void sweep(const std::string& preset_name, int n, std::uint64_t seed, double K_0
     if (std::fabs(material::tau_bar(st.sigma) - u.tau_bar) > 1e-10 * scale) fail("tau_bar(sigma) != tau_bar");
     // structure used by the return map: f_n (staggered) or f_{n+1} (implicit update), recovered from phi_m
     const double fo = (P.steady.phi_j - u.phi_m) / (P.steady.phi_j - P.steady.phi_c);
-    if (u.structure_iterations == 0 && std::fabs(fo - before.f) > 1e-12) fail("staggered update with phi_m != phi_m(f_n)");
+    if (u.structure_iterations == 0 && std::fabs(fo - before.f) > 1e-12)
+      fail("staggered update with phi_m != phi_m(f_n)");
     if (u.structure_iterations > 0 && std::fabs(fo - st.f) > 1e-9) fail("implicit update: phi_m != phi_m(f_{n+1})");
-    const double phim = u.phi_m;  // E1
-    const double a = P.steady.a_0 + (P.steady.a_inf - P.steady.a_0) * fo;       // E2
+    const double phim = u.phi_m;                                           // E1
+    const double a = P.steady.a_0 + (P.steady.a_inf - P.steady.a_0) * fo;  // E2
     const double Gdt = P.granular.G * dt, Kdt = P.granular.K * dt;
     switch (u.regime) {
       case GranularRegime::kElastic: {
@@ -118,7 +119,8 @@ void sweep(const std::string& preset_name, int n, std::uint64_t seed, double K_0
       case GranularRegime::kSeparated:
         if (u.p != 0.0 || u.tau_bar != 0.0) fail("separated with stress");
         if (u.xi_dot_1 < 0.0) fail("xi_dot_1 < 0");
-        if (u.p_trial + Kdt * P.granular.K_3 * phi * u.gamma_dot_p > 1e-10 * scale) fail("separation against dilatancy");
+        if (u.p_trial + Kdt * P.granular.K_3 * phi * u.gamma_dot_p > 1e-10 * scale)
+          fail("separation against dilatancy");
         break;
       case GranularRegime::kShear:
       case GranularRegime::kShearCompaction:
@@ -138,8 +140,8 @@ void sweep(const std::string& preset_name, int n, std::uint64_t seed, double K_0
             // f_3 = 0 (E23): (phi_m - phi)^2 p = (a phi)^2 (gdp^2 d^2 rho_s + 2 eta_0 gdp)
             const double g = u.gamma_dot_p;
             const double lhs = (phim - phi) * (phim - phi) * u.p;
-            const double rhs = a * phi * a * phi *
-                               (g * g * P.granular.d * P.granular.d * P.granular.rho_s + 2.0 * P.steady.eta_0 * g);
+            const double rhs =
+                a * phi * a * phi * (g * g * P.granular.d * P.granular.d * P.granular.rho_s + 2.0 * P.steady.eta_0 * g);
             if (std::fabs(lhs - rhs) > 1e-8 * std::max(lhs, rhs)) fail("f_3 != 0");
             if (u.xi_dot_2 > 0.0) fail("xi_dot_2 > 0");
             if (std::fabs(u.p - (u.p_trial + Kdt * u.xi_dot_2)) > 1e-8 * scale) fail("compaction pressure balance");

@@ -35,7 +35,12 @@ inline double steady_f_at_rate(const rheology::SteadyParams& s, double phi, doub
     for (int k = 0; k < 200 && (b - a) > 1e-15 * b; ++k) {
       const double m = 0.5 * (a + b);
       const double rm = steady_at_f(s, phi, m).shear_rate - rate;
-      if ((rm > 0.0) == (ra > 0.0)) { a = m; ra = rm; } else { b = m; }
+      if ((rm > 0.0) == (ra > 0.0)) {
+        a = m;
+        ra = rm;
+      } else {
+        b = m;
+      }
     }
     const double f = 0.5 * (a + b);
     if (std::isnan(best) || std::fabs(f - f_hint) < std::fabs(best - f_hint)) best = f;

@@ -18,8 +18,8 @@ struct CliRun {
 
 CliRun run(const std::string& args) {
   // One log per test process: ctest runs tests of this file in parallel processes.
-  const std::string log = std::filesystem::temp_directory_path() /
-                          ("oobleck_point_cli_" + std::to_string(::getpid()) + ".log");
+  const std::string log =
+      std::filesystem::temp_directory_path() / ("oobleck_point_cli_" + std::to_string(::getpid()) + ".log");
   const std::string cmd = std::string(OOBLECK_CLI) + " " + args + " > " + log + " 2>&1";
   const int rc = std::system(cmd.c_str());
   std::ifstream in(log);
@@ -61,19 +61,28 @@ TEST(PointCli, BadInputExitsTwoWithoutOutput) {
 
 TEST(PointCli, ShearAndRelaxWriteCsv) {
   const std::string out = tmp("oobleck_point_ok.csv");
-  CliRun r = run("point shear --preset hermes2016 --phi 0.44 --shear-rate 10 --duration 0.5 --dt 1e-3 --samples 20 --out " + out);
+  CliRun r = run(
+      "point shear --preset hermes2016 --phi 0.44 --shear-rate 10 --duration 0.5 --dt 1e-3 --samples 20 --out " + out);
   ASSERT_EQ(r.status, 0) << r.output;
   {
     std::ifstream in(out);
     std::string header;
     std::getline(in, header);
-    EXPECT_EQ(header.rfind("time,strain,shear_rate,shear_stress,granular_shear_stress,granular_pressure,sigma_xy,f,phi,regime", 0), 0u)
+    EXPECT_EQ(
+        header.rfind(
+            "time,strain,shear_rate,shear_stress,granular_shear_stress,granular_pressure,sigma_xy,f,phi,regime", 0),
+        0u)
         << header;
   }
-  r = run("point relax --preset hermes2016 --phi 0.52 --shear-rate 0.05 --G 1e4 --G 1e5 --duration 0.05 --samples 20 --out " + out);
+  r =
+      run("point relax --preset hermes2016 --phi 0.52 --shear-rate 0.05 --G 1e4 --G 1e5 --duration 0.05 --samples 20 "
+          "--out " +
+          out);
   ASSERT_EQ(r.status, 0) << r.output;
   std::ifstream in(out);
   std::string header;
   std::getline(in, header);
-  EXPECT_EQ(header, "case,G,K_0,time,granular_shear_stress,granular_pressure,f,gamma_dot_p,regime,ode_granular_shear_stress,ode_f");
+  EXPECT_EQ(
+      header,
+      "case,G,K_0,time,granular_shear_stress,granular_pressure,f,gamma_dot_p,regime,ode_granular_shear_stress,ode_f");
 }

@@ -84,8 +84,7 @@ TEST(Boundary, SlipWallKeepsTangentialMomentum) {
     s.boundaries()[0].type = WallType::Slip;
     auto& b = s.add_body("block");
     b.set_law(std::make_unique<LinearElasticLaw<PlaneStrain>>(ep));
-    fill_box(b, Vec<2>(0.0, 0.3), Vec<2>(0.4, 0.7), h, 2, 1000.0,
-             [](const Vec<2>&) { return Vec<2>(-0.05, 0.3); });
+    fill_box(b, Vec<2>(0.0, 0.3), Vec<2>(0.4, 0.7), h, 2, 1000.0, [](const Vec<2>&) { return Vec<2>(-0.05, 0.3); });
     const double Py0 = b.total_momentum()[1];
     for (int i = 0; i < 100; ++i) s.step();
     EXPECT_NEAR(b.total_momentum()[1], Py0, 1e-12 * std::fabs(Py0));

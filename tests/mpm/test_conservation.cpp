@@ -130,13 +130,12 @@ TEST(Conservation, ThreeDimensionalSpinningBlock) {
     auto& b = s.add_body("block");
     b.set_law(std::make_unique<LinearElasticLaw<ThreeD>>(ep));
     const Vec<3> w(0.5, -1.0, 2.0);
-    fill_box(b, Vec<3>(-0.3, -0.3, -0.3), Vec<3>(0.3, 0.3, 0.3), h, 2, rho,
-             [&](const Vec<3>& x) {
-               Vec<3> v = w.cross(x);
-               v[0] += 0.1 + 0.2 * x[0];
-               v[2] -= 0.05;
-               return v;
-             });
+    fill_box(b, Vec<3>(-0.3, -0.3, -0.3), Vec<3>(0.3, 0.3, 0.3), h, 2, rho, [&](const Vec<3>& x) {
+      Vec<3> v = w.cross(x);
+      v[0] += 0.1 + 0.2 * x[0];
+      v[2] -= 0.05;
+      return v;
+    });
     const double d = k == ShapeKind::CubicBSpline ? h * h / 3.0 : h * h / 4.0;
     auto ang = [&]() {
       Vec<3> L = Vec<3>::Zero();

@@ -47,7 +47,7 @@ TEST(Contact, NodeImpulsesThreeBodyTwoBodyAndCoulomb) {
     const double mu = trial % 3 == 0 ? 0.0 : 0.05 + 2.0 * (trial % 11) / 10.0;
     Vec<3> Js, Jf;
     const bool active = contact_impulses<3>(n, mb, vb, ms, vs, mf, vf, mu, Js, Jf);
-    const bool app_s = vs.dot(n) < vb.dot(n), app_f = mf > 0.0 && vf.dot(n) < vb.dot(n);
+    const bool app_s = vs.dot(n)<vb.dot(n), app_f = mf> 0.0 && vf.dot(n) < vb.dot(n);
     ASSERT_EQ(active, app_s || app_f);
     if (!active) continue;
     const Vec<3> vs1 = vs + Js / ms, vf1 = mf > 0.0 ? Vec<3>(vf + Jf / mf) : vf;
@@ -134,13 +134,15 @@ Flight free_flight(bool rigid, bool with_fluid, double mu) {
   fill_box(solid, Vec<2>(0.25, 0.3), Vec<2>(0.55, 0.5), h, 2, 2000.0, [](const Vec<2>&) { return Vec<2>(1.0, 0.05); });
   auto& grains = s.add_body("grains", Phase::Grains);
   grains.set_law(std::make_unique<LinearElasticLaw<PlaneStrain>>(elastic(2e5)));
-  fill_box(grains, Vec<2>(0.6, 0.2), Vec<2>(0.9, 0.6), h, 2, 0.5 * 1620.0, [](const Vec<2>&) { return Vec<2>::Zero(); });
+  fill_box(grains, Vec<2>(0.6, 0.2), Vec<2>(0.9, 0.6), h, 2, 0.5 * 1620.0,
+           [](const Vec<2>&) { return Vec<2>::Zero(); });
   if (with_fluid) {
     auto& fluid = s.add_body("fluid", Phase::Fluid);
     FluidParams fp;
     fp.kappa_Pa = 2e5;
     fluid.set_law(std::make_unique<FluidLaw<PlaneStrain>>(fp, opt.mixture.min_porosity));
-    fill_box(fluid, Vec<2>(0.6, 0.2), Vec<2>(0.9, 0.6), h, 2, 0.5 * 1000.0, [](const Vec<2>&) { return Vec<2>::Zero(); });
+    fill_box(fluid, Vec<2>(0.6, 0.2), Vec<2>(0.9, 0.6), h, 2, 0.5 * 1000.0,
+             [](const Vec<2>&) { return Vec<2>::Zero(); });
   }
   if (rigid) {
     s.set_free_rigid(0, Vec<2>(1.0, 0.05));
@@ -277,8 +279,10 @@ TEST(Contact, BlockSlidingWithFrictionDeceleratesAtMuG) {
   const double slope = (n * stv - st * sv) / (n * stt - st * st);
   // Measured 3.12 m/s² (+6%; 4.4% at twice the resolution): the excess is the leading edge's
   // tilted normals. A missing or extra 1/Δt in either branch would be off by Δt^±1 ~ 1e3.
-  std::printf("[ measured ] sliding block: deceleration %.4f m/s^2 (mu g = %.4f), F_x/F_y %.4f, "
-              "N/(M g) %.4f, v_end %.2e\n", -slope, mu * g, r.coulomb_ratio, r.mean_fy / (r.mass * g), r.vx_end);
+  std::printf(
+      "[ measured ] sliding block: deceleration %.4f m/s^2 (mu g = %.4f), F_x/F_y %.4f, "
+      "N/(M g) %.4f, v_end %.2e\n",
+      -slope, mu * g, r.coulomb_ratio, r.mean_fy / (r.mass * g), r.vx_end);
   EXPECT_NEAR(-slope, mu * g, 0.10 * mu * g);
   EXPECT_NEAR(r.coulomb_ratio, mu, 0.10 * mu);
   EXPECT_NEAR(r.mean_fy, r.mass * g, 0.02 * r.mass * g);
@@ -393,8 +397,8 @@ Floating float_rod() {
   s.boundaries()[2].type = WallType::Slip;
   auto& fluid = s.add_body("fluid", Phase::Fluid);
   FluidParams fp;
-  fp.kappa_Pa = 4e4;      // c = 6.3 m/s; hydrostatic strain ρ g D/κ = 0.4%
-  fp.eta_0_Pa_s = 0.05;   // damps the rod's heave (period 2π √(d/g) ≈ 0.14 s)
+  fp.kappa_Pa = 4e4;     // c = 6.3 m/s; hydrostatic strain ρ g D/κ = 0.4%
+  fp.eta_0_Pa_s = 0.05;  // damps the rod's heave (period 2π √(d/g) ≈ 0.14 s)
   fp.rho_f0_kg_m3 = rho_f;
   auto law = std::make_unique<FluidLaw<Axisymmetric>>(fp, opt.mixture.min_porosity);
   auto* fl = law.get();
@@ -425,8 +429,10 @@ Floating float_rod() {
     }
   }
   const double zc = zsum / tsum, F = fsum / tsum;
-  std::printf("[ measured ] floating rod: centre %.4f mm vs Archimedes %.4f mm (draft %.2f mm, h = %.1f mm); "
-              "F/(M g) = %.4f\n", 1e3 * zc, 1e3 * zc_ref, 1e3 * d, 1e3 * h, F / (M * g));
+  std::printf(
+      "[ measured ] floating rod: centre %.4f mm vs Archimedes %.4f mm (draft %.2f mm, h = %.1f mm); "
+      "F/(M g) = %.4f\n",
+      1e3 * zc, 1e3 * zc_ref, 1e3 * d, 1e3 * h, F / (M * g));
   double zb = 1e9;
   for (const auto& x : rod.x_m) zb = std::min(zb, x[1]);
   return {zc, zc_ref, F / (M * g), h, zb};

@@ -28,7 +28,7 @@ namespace {
 struct SettlingResult {
   double u_settle_m_s;  // grains, downward, zero-volume-flux frame
   double u_exact_m_s;
-  double momentum_y;    // total mixture momentum (should stay 0)
+  double momentum_y;  // total mixture momentum (should stay 0)
   double momentum_scale;
   double max_pressure_Pa;
 };
@@ -146,7 +146,8 @@ TEST(SettlingV4, AxisymmetricColumnSameVelocity) {
   dp.eta_0_Pa_s = eta0;
   double dv = 0.0;
   for (int it = 0; it < 100; ++it)
-    dv = (rho_s - rho_f) * g * d * d / (18.0 * eta0 * mat::drag_F(dp, phi, mat::drag_reynolds(dv, 1.0 - phi, rho_f, d, eta0)));
+    dv = (rho_s - rho_f) * g * d * d /
+         (18.0 * eta0 * mat::drag_F(dp, phi, mat::drag_reynolds(dv, 1.0 - phi, rho_f, d, eta0)));
   const double u_exact = (1.0 - phi) * dv;
   // Every point (not only the mean) settles at the balance velocity, also next to the axis/wall.
   for (std::int64_t p = 0; p < grains.size(); ++p) {

@@ -34,8 +34,8 @@ std::vector<Vec<D>> sample_points(const Grid<D>& g, int n, unsigned seed) {
     Vec<D> p;
     for (int a = 0; a < D; ++a) {
       double r = u(rng);
-      if (q % 4 == 1) r = 0.5 * u(rng) / g.cells[a];              // near lower wall
-      if (q % 4 == 2) r = 1.0 - 0.5 * u(rng) / g.cells[a];        // near upper wall
+      if (q % 4 == 1) r = 0.5 * u(rng) / g.cells[a];                           // near lower wall
+      if (q % 4 == 2) r = 1.0 - 0.5 * u(rng) / g.cells[a];                     // near upper wall
       if (q % 4 == 3) r = std::floor(u(rng) * (g.cells[a] + 1)) / g.cells[a];  // on a node/wall
       if (g.periodic[a] && r >= 1.0) r = 0.0;
       p[a] = g.origin_m[a] + r * g.length(a);
@@ -59,26 +59,28 @@ void check_kernel(const Kernel& kernel, bool periodic) {
     // The hot-loop traversal (for_each_node) and the per-node accessors give the same nodes and
     // values in the same order.
     int k = 0;
-    for_each_node<D, Kernel::support>(c.template stencil<Kernel::support>(static_cast<std::int64_t>(p)), [&](int i, double w, const double* gr, const double* of) {
-      const Vec<D> grad = Eigen::Map<const Vec<D>>(gr), off = Eigen::Map<const Vec<D>>(of);
-      EXPECT_EQ(i, c.node(p, k));
-      EXPECT_EQ(w, c.weight(p, k));
-      EXPECT_EQ(grad, c.gradient(p, k));
-      EXPECT_EQ(off, c.offset(p, k));
-      ++k;
-      EXPECT_GE(w, -1e-15);
-      sw += w;
-      sg += grad;
-      sx += w * off;
-      xg += off * grad.transpose();
-      // The cached offset is the node position minus the point position (unwrapped).
-      Vec<D> xi = g.node_position(i);
-      for (int a = 0; a < D; ++a) {
-        double d = xi[a] - x[p][a] - off[a];
-        if (g.periodic[a]) d -= g.length(a) * std::round(d / g.length(a));
-        EXPECT_NEAR(d, 0.0, 1e-12);
-      }
-    });
+    for_each_node<D, Kernel::support>(c.template stencil<Kernel::support>(static_cast<std::int64_t>(p)),
+                                      [&](int i, double w, const double* gr, const double* of) {
+                                        const Vec<D> grad = Eigen::Map<const Vec<D>>(gr),
+                                                     off = Eigen::Map<const Vec<D>>(of);
+                                        EXPECT_EQ(i, c.node(p, k));
+                                        EXPECT_EQ(w, c.weight(p, k));
+                                        EXPECT_EQ(grad, c.gradient(p, k));
+                                        EXPECT_EQ(off, c.offset(p, k));
+                                        ++k;
+                                        EXPECT_GE(w, -1e-15);
+                                        sw += w;
+                                        sg += grad;
+                                        sx += w * off;
+                                        xg += off * grad.transpose();
+                                        // The cached offset is the node position minus the point position (unwrapped).
+                                        Vec<D> xi = g.node_position(i);
+                                        for (int a = 0; a < D; ++a) {
+                                          double d = xi[a] - x[p][a] - off[a];
+                                          if (g.periodic[a]) d -= g.length(a) * std::round(d / g.length(a));
+                                          EXPECT_NEAR(d, 0.0, 1e-12);
+                                        }
+                                      });
     EXPECT_EQ(k, K);
     EXPECT_NEAR(sw, 1.0, 1e-13) << "partition of unity at p=" << p;
     EXPECT_NEAR(sg.norm(), 0.0, 1e-11) << "sum of gradients at p=" << p;

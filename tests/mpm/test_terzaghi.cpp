@@ -33,7 +33,7 @@ TEST(TerzaghiV5, PorePressureMatchesSeriesSolution) {
   const double H = 1.0, h = H / 16, phi = 0.5, n = 1.0 - phi, rho = 1000.0, q = 100.0;
   const double M = 1e5, kappa = 1e7, eta = 1e-3;
   // q/M = 0.1% strain keeps the porosity (and so C_V, c_v) constant as Terzaghi assumes.
-  const double c_v = 0.5;                              // [m²/s] chosen; T_c = H²/c_v = 2 s
+  const double c_v = 0.5;                                  // [m²/s] chosen; T_c = H²/c_v = 2 s
   const double C_V = n * n / c_v / (1.0 / M + n / kappa);  // drag per volume giving that c_v
   // Carman–Kozeny C_V = 180 φ² η/(d² n) ⇒ the grain size that gives C_V.
   const double d = std::sqrt(180.0 * phi * phi * eta / (n * C_V));

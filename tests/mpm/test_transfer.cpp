@@ -169,9 +169,9 @@ void check_g2p(const Kernel& kernel, Transfer transfer, bool mixture) {
     return c;
   }();
   const double alpha = 0.95, dt = 1e-3;
-  const std::int64_t bad = phases::grid_to_particles<G, K>(b, cache, field, st.grid, transfer, alpha, dt,
-                                                   mixture ? porosity.data() : nullptr,
-                                                   mixture ? flux.data() : nullptr);
+  const std::int64_t bad =
+      phases::grid_to_particles<G, K>(b, cache, field, st.grid, transfer, alpha, dt,
+                                      mixture ? porosity.data() : nullptr, mixture ? flux.data() : nullptr);
   EXPECT_EQ(bad, kAllFinite);
   for (std::int64_t p = 0; p < b.size(); ++p) {
     Vec<NC> v_pic = Vec<NC>::Zero(), dv = Vec<NC>::Zero(), q = Vec<NC>::Zero();
@@ -203,7 +203,8 @@ void check_g2p(const Kernel& kernel, Transfer transfer, bool mixture) {
         for (int a = 0; a < D; ++a) ASSERT_NEAR(b.C_1_s[p](c, a), C(c, a), 1e-11 * std::max(1.0, std::fabs(C(c, a))));
     }
     const Mat3 L = G::velocity_gradient(grad, x0, v_pic);
-    for (int k = 0; k < 9; ++k) ASSERT_NEAR(b.L_1_s[p].data()[k], L.data()[k], 1e-11 * std::max(1.0, L.cwiseAbs().maxCoeff()));
+    for (int k = 0; k < 9; ++k)
+      ASSERT_NEAR(b.L_1_s[p].data()[k], L.data()[k], 1e-11 * std::max(1.0, L.cwiseAbs().maxCoeff()));
     ASSERT_NEAR(b.volume_m3[p], before.volume_m3[p] * std::exp(dt * L.trace()), 1e-14 * before.volume_m3[p]);
     if (mixture) {
       if constexpr (G::has_hoop_terms) div_q += G::div_extra(q, x0);
@@ -449,10 +450,10 @@ void check_g2p_blocks_in_any_order() {
       b->v_m_s[bad_hi][0] = std::nan("");
       b->v_m_s[bad_lo][0] = std::nan("");
     }
-    const std::int64_t whole = phases::grid_to_particles<G, K>(s1.body, cache, field, s1.grid, t, 0.95, 1e-3,
-                                                       porosity.data(), flux.data());
-    const G2PTask<G> task = make_g2p_task<G, K>(s2.body, cache, field, s2.grid, t, 0.95, 1e-3,
-                                                porosity.data(), flux.data());
+    const std::int64_t whole =
+        phases::grid_to_particles<G, K>(s1.body, cache, field, s1.grid, t, 0.95, 1e-3, porosity.data(), flux.data());
+    const G2PTask<G> task =
+        make_g2p_task<G, K>(s2.body, cache, field, s2.grid, t, 0.95, 1e-3, porosity.data(), flux.data());
     ASSERT_EQ(task.blocks, (s2.body.size() + oobleck::numerics::kMathBlock - 1) / oobleck::numerics::kMathBlock);
     ASSERT_GE(task.blocks, 3);
     std::int64_t bad = kAllFinite;

@@ -60,8 +60,7 @@ TEST(WaveV2, PeriodMatchesSemiDiscreteDispersion) {
       const int n = 16;
       const auto r = run_standing_wave(k, flip ? Transfer::FlipPicBlend : Transfer::Apic, 1.0, n, false);
       const double predicted = kernel_period_error(k, 2.0 * M_PI / n, flip);
-      EXPECT_NEAR(r.rel_period_error, predicted, 0.1 * predicted)
-          << "kind " << static_cast<int>(k) << " flip " << flip;
+      EXPECT_NEAR(r.rel_period_error, predicted, 0.1 * predicted) << "kind " << static_cast<int>(k) << " flip " << flip;
     }
   }
 }

@@ -22,8 +22,8 @@ struct WaveResult {
 ///  * `fixed_ends = true`: frictionless walls at x = 0 and x = L (v_x = 0 on the face and ghost
 ///    nodes), v_x = V sin(πx/L), period 2L/c.
 /// c = √(M/ρ), M = λ + 2μ. Runs `periods` periods at Δt = cfl h/c with `ppc`² points per cell.
-inline WaveResult run_standing_wave(ShapeKind shape, Transfer transfer, double flip, int cells_x,
-                                    bool fixed_ends, int periods = 2, double cfl = 0.1, int ppc = 2) {
+inline WaveResult run_standing_wave(ShapeKind shape, Transfer transfer, double flip, int cells_x, bool fixed_ends,
+                                    int periods = 2, double cfl = 0.1, int ppc = 2) {
   const double L = 1.0, rho = 1000.0, V = 1e-4;
   material::LinearElasticParams ep;
   ep.youngs_modulus_Pa = 1e7;

@@ -7,7 +7,9 @@
 
 namespace paper {
 
-struct Term { double phi_i, alpha; };
+struct Term {
+  double phi_i, alpha;
+};
 struct Fit {
   std::string name;
   double phi_c, phi_j, a_0, a_inf, tau_star, eta_0, mu_c, Delta;

@@ -29,8 +29,7 @@ struct Synthetic {
 
 /// n points of `kind` at phi from `model` on [phi_lo, phi_hi] (for dst: log-spaced in phi_j - phi),
 /// each multiplied by (1 + 0.02 N(0, 1)) with a fixed seed.
-Synthetic synthesize(FitKind kind, const SteadyParams& truth, double phi_lo, double phi_hi, int n,
-                     unsigned seed) {
+Synthetic synthesize(FitKind kind, const SteadyParams& truth, double phi_lo, double phi_hi, int n, unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> normal(0.0, 1.0);
   Synthetic s;
@@ -43,8 +42,8 @@ Synthetic synthesize(FitKind kind, const SteadyParams& truth, double phi_lo, dou
     }
     double v = 0.0;
     switch (kind) {
-      case FitKind::low: v = eta_r_low(truth, phi); break;    // E12
-      case FitKind::high: v = eta_r_high(truth, phi); break;  // E13
+      case FitKind::low: v = eta_r_low(truth, phi); break;               // E12
+      case FitKind::high: v = eta_r_high(truth, phi); break;             // E13
       case FitKind::dst: v = shear_rate_dst(truth, phi).value(); break;  // E14
     }
     s.phi.push_back(phi);
@@ -209,12 +208,12 @@ TEST(Fit, FittedTomlRoundTrips) {
 TEST(Fit, RejectsBadData) {
   const SteadyParams base = load_preset("hermes2016").steady;
   const std::vector<double> phi = {0.2, 0.3, 0.4}, eta = {2.0, 4.0, 9.0};
-  EXPECT_THROW(fit(FitKind::low, {0.2, 0.3}, {2.0, 4.0}, base), InputError);           // n < p + 1
-  EXPECT_THROW(fit(FitKind::low, {0.2, 1.3, 0.4}, eta, base), InputError);             // phi outside (0,1)
+  EXPECT_THROW(fit(FitKind::low, {0.2, 0.3}, {2.0, 4.0}, base), InputError);  // n < p + 1
+  EXPECT_THROW(fit(FitKind::low, {0.2, 1.3, 0.4}, eta, base), InputError);    // phi outside (0,1)
   EXPECT_THROW(fit(FitKind::low, {0.2, 0.0, 0.4}, eta, base), InputError);
-  EXPECT_THROW(fit(FitKind::low, phi, {2.0, -4.0, 9.0}, base), InputError);            // non-positive
-  EXPECT_THROW(fit(FitKind::low, phi, {2.0, 4.0}, base), InputError);                  // size mismatch
-  EXPECT_THROW(fit(FitKind::high, {0.2, 0.3, 0.6}, eta, base), InputError);            // phi >= base phi_j
+  EXPECT_THROW(fit(FitKind::low, phi, {2.0, -4.0, 9.0}, base), InputError);                // non-positive
+  EXPECT_THROW(fit(FitKind::low, phi, {2.0, 4.0}, base), InputError);                      // size mismatch
+  EXPECT_THROW(fit(FitKind::high, {0.2, 0.3, 0.6}, eta, base), InputError);                // phi >= base phi_j
   EXPECT_THROW(fit(FitKind::high, {0.2, 0.3, base.phi_j - 1e-8}, eta, base), InputError);  // no room for phi_c
   EXPECT_THROW(fit(FitKind::low, {0.2, 0.3, 1.0 - 1e-8}, eta, base), InputError);          // no room for phi_j
   EXPECT_THROW(fit(FitKind::dst, {0.45, 0.47, 0.3, 0.5, 0.51}, {1, 2, 3, 4, 5}, base), InputError);  // < phi_c

@@ -68,16 +68,17 @@ TEST(FlowCurve, EveryRowIsASteadyStateE10) {
       const double inv_eta_B = 1.0 / paper::eta_B(fit, phi);
       double f_prev = -1.0;
       for (const auto& r : rheology::flow_curve(p.steady, phi, 200)) {
-        const double H = std::pow(r.granular_shear_stress / fit.tau_star, 1.5);            // E7
-        const double S = 1.0 + r.granular_shear_stress * inv_eta_B / r.shear_rate;        // E7
-        ASSERT_LE(rel(r.f, H * fm / (H + S)), 1e-10) << "f=" << r.f;                        // E10
+        const double H = std::pow(r.granular_shear_stress / fit.tau_star, 1.5);     // E7
+        const double S = 1.0 + r.granular_shear_stress * inv_eta_B / r.shear_rate;  // E7
+        ASSERT_LE(rel(r.f, H * fm / (H + S)), 1e-10) << "f=" << r.f;                // E10
         // E3 = fluid (Einstein) + granular; E5 tau_bar = (mu_c + mu_h) p.
         ASSERT_LE(rel(r.shear_stress, fit.eta_0 * r.shear_rate * (1 + 2.5 * phi) + r.granular_shear_stress), 1e-12);
         const double phim = fit.phi_j + (fit.phi_c - fit.phi_j) * r.f;
         const double a = fit.a_0 + (fit.a_inf - fit.a_0) * r.f;
         if (phim - phi > 1e-6) {
           ASSERT_LE(rel(r.granular_pressure, 2 * std::pow(a * phi / (phim - phi), 2) * fit.eta_0 * r.shear_rate), 1e-8);
-          ASSERT_LE(rel(r.granular_shear_stress, (fit.mu_c + 1.25 * (phim - phi) / (a * a)) * r.granular_pressure), 1e-8);
+          ASSERT_LE(rel(r.granular_shear_stress, (fit.mu_c + 1.25 * (phim - phi) / (a * a)) * r.granular_pressure),
+                    1e-8);
         }
         ASSERT_GT(r.f, f_prev);  // rows ordered by increasing f
         f_prev = r.f;
@@ -226,7 +227,8 @@ TEST(FlowCurve, FastestSteadyShearOfTheAnnularCell) {
   fit.eta_0 = 0.010;
   const double phi = 0.505;
   const double eta_B = 1.0 / (1.86e4 * std::pow(0.535 - phi, 4) + 9.3e-3 * std::pow(0.535 - phi, 0.1));
-  const double dst = 5.35 / 0.010 * std::pow(2 * 1.19 * std::pow(eta_B / 0.010 * 0.8 * phi / (0.535 - phi), 2), -1.0 / 3.0);
+  const double dst =
+      5.35 / 0.010 * std::pow(2 * 1.19 * std::pow(eta_B / 0.010 * 0.8 * phi / (0.535 - phi), 2), -1.0 / 3.0);
   EXPECT_NEAR(dst, 0.255, 0.001);
   double scan = 0.0;
   const double fu = (phi - 0.535) / (0.436 - 0.535);

@@ -42,8 +42,10 @@ namespace {
 struct TempToml {
   std::string path;
   explicit TempToml(const std::string& text) {
-    path = (std::filesystem::temp_directory_path() / ("oobleck_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
-                                                       ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".toml")).string();
+    path = (std::filesystem::temp_directory_path() /
+            ("oobleck_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+             ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".toml"))
+               .string();
     std::ofstream(path) << text;
   }
   ~TempToml() { std::remove(path.c_str()); }

@@ -26,7 +26,7 @@ namespace {
 const std::string kScenes = std::string(OOBLECK_SOURCE_DIR) + "/scenes/verification/";
 
 nlohmann::json run_verification(const std::string& scene, const std::string& out, std::vector<std::string> sets = {},
-                   run::RunOptions o = {}) {
+                                run::RunOptions o = {}) {
   o.out_dir = out;
   o.quiet = true;
   if (o.threads == 0) o.threads = 1;
@@ -201,11 +201,13 @@ TEST(RunScenes, RunFolderIsCreatedWithItsParents) {
   // be is an error naming it.
   clitest::TempDir d;
   const std::string scene = kScenes + "settling.toml";
-  const auto ok = clitest::run("run " + scene + " --out " + d / "a/b/run" + " --quiet --threads 1 --set time.duration=0.006");
+  const auto ok =
+      clitest::run("run " + scene + " --out " + d / "a/b/run" + " --quiet --threads 1 --set time.duration=0.006");
   EXPECT_EQ(ok.status, 0) << ok.output;
   EXPECT_TRUE(fs::exists(d / "a/b/run/summary.json")) << ok.output;
   std::ofstream(d / "file") << "x";
-  const auto bad = clitest::run("run " + scene + " --out " + d / "file/run" + " --quiet --threads 1 --set time.duration=0.006");
+  const auto bad =
+      clitest::run("run " + scene + " --out " + d / "file/run" + " --quiet --threads 1 --set time.duration=0.006");
   EXPECT_EQ(bad.status, 2) << bad.output;
   EXPECT_NE(bad.output.find("cannot create the run folder"), std::string::npos) << bad.output;
 }

@@ -49,9 +49,9 @@ TEST(SceneConfig, SettlingSceneLoads) {
   EXPECT_EQ(c.grid.cells[0], 4);
   EXPECT_EQ(c.grid.cells[1], 20);
   EXPECT_EQ(c.material.name, "hermes2016");
-  EXPECT_DOUBLE_EQ(c.material.granular.d, 1e-4);       // override
-  EXPECT_DOUBLE_EQ(c.material.steady.phi_j, 0.535);    // from the preset
-  EXPECT_DOUBLE_EQ(c.material.steady.eta_0, 1e-3);     // fluid viscosity is the one viscosity
+  EXPECT_DOUBLE_EQ(c.material.granular.d, 1e-4);     // override
+  EXPECT_DOUBLE_EQ(c.material.steady.phi_j, 0.535);  // from the preset
+  EXPECT_DOUBLE_EQ(c.material.steady.eta_0, 1e-3);   // fluid viscosity is the one viscosity
   EXPECT_EQ(c.boundary[0].type, scene::BoundaryType::Periodic);
   ASSERT_EQ(c.regions.size(), 1u);
   EXPECT_DOUBLE_EQ(c.regions[0].phi, 0.1);
@@ -195,15 +195,19 @@ TEST(SceneConfig, BodyErrorsNameTheKeyAndRule) {
   EXPECT_NE(intrusion_error("density = 2700.0", "mass = 1.0").find("only a free rigid body takes a mass"),
             std::string::npos);
   EXPECT_NE(intrusion_error("max = [0.005, 0.035]", "max = [0.005, 0.045]").find("inside the grid"), std::string::npos);
-  EXPECT_NE(intrusion_error("motion = \"prescribed\"", "motion = \"rigid\"").find("must be one of prescribed, free, elastic"), std::string::npos);
+  EXPECT_NE(
+      intrusion_error("motion = \"prescribed\"", "motion = \"rigid\"").find("must be one of prescribed, free, elastic"),
+      std::string::npos);
   EXPECT_NE(intrusion_error("friction = 0.3", "friction = 0.3\nmotor_omega = 3").find("only an elastic body"),
             std::string::npos);
   EXPECT_NE(intrusion_error("ramp_time = 0.0 ", "ramp_time = -0.001 ").find("body[0].ramp_time"), std::string::npos);
-  EXPECT_NE(intrusion_error({{"motion = \"prescribed\"", "motion = \"free\""}, {"ramp_time = 0.0 ", "ramp_time = 0.002 "}})
-                .find("only a prescribed body"),
-            std::string::npos);
-  EXPECT_NE(intrusion_error("kind = \"intrusion\"", "kind = \"intrusion\"\nbody = \"rod\"").find("no [[body]] has that name"),
-            std::string::npos);
+  EXPECT_NE(
+      intrusion_error({{"motion = \"prescribed\"", "motion = \"free\""}, {"ramp_time = 0.0 ", "ramp_time = 0.002 "}})
+          .find("only a prescribed body"),
+      std::string::npos);
+  EXPECT_NE(
+      intrusion_error("kind = \"intrusion\"", "kind = \"intrusion\"\nbody = \"rod\"").find("no [[body]] has that name"),
+      std::string::npos);
   EXPECT_NE(intrusion_error("kind = \"intrusion\"", "kind = \"wheel\"").find("plane-strain grid"), std::string::npos);
   EXPECT_NE(intrusion_error("name = \"intruder\"", "name = \"grains\"").find("differ from the phases"),
             std::string::npos);

@@ -105,8 +105,8 @@ TEST(PaperScenes, AnnularShearFastBobGrowsAJammedCoRotatingBand) {
 TEST(PaperScenes, AnnularShearSlowBobAdmitsASteadyFlow) {
   // S1 at u_i = 0.84 mm/s: below the fastest steady flow of the bed (see the fast case above).
   clitest::TempDir d;
-  const auto s = run_paper_scene("annular_shear.toml", d / "run",
-                                 {"grid.cell_size=0.002", "duration=0.01", "u_inner=0.00084"});
+  const auto s =
+      run_paper_scene("annular_shear.toml", d / "run", {"grid.cell_size=0.002", "duration=0.01", "u_inner=0.00084"});
   const auto& sf = s["steady_flow"];
   EXPECT_TRUE(sf["steady_flow_possible"].get<bool>());
   EXPECT_GT(sf["bob_speed_limit"].get<double>(), 0.00084);
@@ -124,11 +124,12 @@ TEST(PaperScenes, AnnularShearBandIsDraggedOutThenReleased) {
   clitest::TempDir d;
   const auto s = run_paper_scene("annular_shear.toml", d / "run", {"grid.cell_size=0.002", "duration=0.1"});
   const auto& a = s["outer_arrest"];
-  std::printf("[ measured ] coarse annular: outer rotation peak %.3f at %.3f s, arrest at %s s, front farthest %.4f m "
-              "at %.3f s, structure at the wall at %s s\n",
-              a["peak"].get<double>(), a["peak_time"].get<double>(), a["time"].dump().c_str(),
-              s["front_farthest"].get<double>(), s["front_farthest_time"].get<double>(),
-              s["structure_front_wall_time"].dump().c_str());
+  std::printf(
+      "[ measured ] coarse annular: outer rotation peak %.3f at %.3f s, arrest at %s s, front farthest %.4f m "
+      "at %.3f s, structure at the wall at %s s\n",
+      a["peak"].get<double>(), a["peak_time"].get<double>(), a["time"].dump().c_str(),
+      s["front_farthest"].get<double>(), s["front_farthest_time"].get<double>(),
+      s["structure_front_wall_time"].dump().c_str());
   EXPECT_GT(a["peak"].get<double>(), 0.2);
   ASSERT_TRUE(a["time"].is_number());
   EXPECT_GT(a["time"].get<double>(), a["peak_time"].get<double>());
@@ -165,9 +166,10 @@ TEST(PaperScenes, FastWheelRidesHigherAndTravelsFurtherThanTheSlowOne) {
   };
   const auto fast = run_paper_scene("wheel.toml", d / "fast", with("10"));
   const auto slow = run_paper_scene("wheel.toml", d / "slow", with("1"));
-  std::printf("[ measured ] coarse wheel: omega 10: hub %.3f m, distance %.3f m; omega 1: hub %.3f m, distance %.3f m\n",
-              fast["hub_height_final"].get<double>(), fast["distance"].get<double>(),
-              slow["hub_height_final"].get<double>(), slow["distance"].get<double>());
+  std::printf(
+      "[ measured ] coarse wheel: omega 10: hub %.3f m, distance %.3f m; omega 1: hub %.3f m, distance %.3f m\n",
+      fast["hub_height_final"].get<double>(), fast["distance"].get<double>(), slow["hub_height_final"].get<double>(),
+      slow["distance"].get<double>());
   const double surface = slow["bed_surface"].get<double>();
   EXPECT_NEAR(surface, 0.5, 0.02);
   EXPECT_LT(slow["hub_height_final"].get<double>(), surface);  // the slow wheel sinks
@@ -203,8 +205,8 @@ TEST(PaperScenes, WheelRunRestartsWithTheSameMeasurements) {
   // Coarse fast wheel stopped at step 1700 (0.34 s, between frames) and restarted: hub track and
   // the per-frame pressure scatter (checkpointed) as in the uninterrupted run.
   clitest::TempDir d;
-  const auto r = run_and_restart("wheel.toml", {"cells=[50,25]", "time.dt=2e-4", "duration=0.6", "omega=10"}, 500,
-                                 1700, d / "wheel");
+  const auto r = run_and_restart("wheel.toml", {"cells=[50,25]", "time.dt=2e-4", "duration=0.6", "omega=10"}, 500, 1700,
+                                 d / "wheel");
   ASSERT_EQ(r.full["pressure_scatter"]["series"].size(), 13u);
   EXPECT_EQ(r.full["pressure_scatter"], r.part["pressure_scatter"]);
   EXPECT_EQ(r.full["hub_height"], r.part["hub_height"]);
@@ -224,9 +226,9 @@ TEST(PaperScenes, IntruderRampsUpToSpeedAlongTheClosedFormPath) {
     double ramp, duration;
   };
   for (const Case c : {Case{0.004, 0.002}, Case{0.001, 0.002}}) {
-    const auto s = run_paper_scene("intrusion.toml", d / "ramp",
-                                   {"cell_size=0.0025", fmt::format("duration={}", c.duration),
-                                    fmt::format("ramp_time={}", c.ramp)});
+    const auto s = run_paper_scene(
+        "intrusion.toml", d / "ramp",
+        {"cell_size=0.0025", fmt::format("duration={}", c.duration), fmt::format("ramp_time={}", c.ramp)});
     const double t = s["time"].get<double>();
     const double expected = t < c.ramp ? v0 * t * t / (2 * c.ramp) : v0 * (t - 0.5 * c.ramp);
     const auto& body = s["bodies"]["intruder"];
@@ -244,8 +246,8 @@ TEST(PaperScenes, RestartInsideTheRampContinuesBitForBit) {
   // The ramped velocity is a function of the (checkpointed) time: stopping inside the ramp and
   // restarting gives the uninterrupted run's state bit for bit.
   clitest::TempDir d;
-  const auto r = run_and_restart("intrusion.toml", {"cell_size=0.0025", "duration=0.003", "ramp_time=0.004"}, 200,
-                                 100, d / "ramp");
+  const auto r = run_and_restart("intrusion.toml", {"cell_size=0.0025", "duration=0.003", "ramp_time=0.004"}, 200, 100,
+                                 d / "ramp");
   ASSERT_EQ(r.full_cp.step(), r.part_cp.step());
   ASSERT_GE(r.full_cp.step(), 200);
   expect_same_state(r.full_cp, r.part_cp);

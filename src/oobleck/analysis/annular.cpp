@@ -16,13 +16,13 @@ void check_geometry(const AnnularGeometry& g, const char* what) {
   if (!(std::isfinite(g.bob_radius_m) && g.bob_radius_m > 0.0))
     throw InputError(fmt::format("{}: bob radius r_0 = {} m must be finite and > 0", what, g.bob_radius_m));
   if (!(std::isfinite(g.outer_radius_m) && g.outer_radius_m > g.bob_radius_m))
-    throw InputError(fmt::format("{}: outer radius r_o = {} m must be finite and > r_0 = {} m", what,
-                                 g.outer_radius_m, g.bob_radius_m));
+    throw InputError(fmt::format("{}: outer radius r_o = {} m must be finite and > r_0 = {} m", what, g.outer_radius_m,
+                                 g.bob_radius_m));
   if (!(std::isfinite(g.bob_speed_m_per_s) && g.bob_speed_m_per_s != 0.0))
     throw InputError(fmt::format("{}: bob speed u_i = {} m/s must be finite and non-zero", what, g.bob_speed_m_per_s));
   if (!std::isfinite(g.sample_z_m) || !std::isfinite(g.start_time_s))
-    throw InputError(fmt::format("{}: sample z = {} m and start time = {} s must be finite", what, g.sample_z_m,
-                                 g.start_time_s));
+    throw InputError(
+        fmt::format("{}: sample z = {} m and start time = {} s must be finite", what, g.sample_z_m, g.start_time_s));
 }
 
 void check_frame_fits(const GridField2D& f, const AnnularGeometry& g, const std::string& what) {
@@ -72,14 +72,14 @@ std::vector<ShearProfile> surface_profiles(const std::vector<ShearFrame>& frames
   const std::vector<std::size_t> nodes = gap_nodes(grid, geometry, false);
   std::vector<ShearProfile> out;
   for (const double theta : angles_rad) {
-    if (!std::isfinite(theta))
-      throw InputError(fmt::format("surface_profiles: angle {} rad is not finite", theta));
+    if (!std::isfinite(theta)) throw InputError(fmt::format("surface_profiles: angle {} rad is not finite", theta));
     const double t = geometry.start_time_s + theta * geometry.bob_radius_m / std::abs(geometry.bob_speed_m_per_s);
     const double tol = 1e-9 * std::max(1.0, std::abs(t));
     if (t < frames.front().time_s - tol || t > frames.back().time_s + tol)
-      throw InputError(fmt::format("surface_profiles: angle {} rad is reached at t = {} s, outside the frames' "
-                                   "time range [{}, {}] s",
-                                   theta, t, frames.front().time_s, frames.back().time_s));
+      throw InputError(
+          fmt::format("surface_profiles: angle {} rad is reached at t = {} s, outside the frames' "
+                      "time range [{}, {}] s",
+                      theta, t, frames.front().time_s, frames.back().time_s));
     std::size_t k = 0;
     while (k + 2 < frames.size() && frames[k + 1].time_s < t) ++k;
     double w = 0.0;
@@ -88,9 +88,8 @@ std::vector<ShearProfile> surface_profiles(const std::vector<ShearFrame>& frames
       w = std::clamp(w, 0.0, 1.0);
     }
     const std::vector<double> a = frames[k].v_theta.row_at(geometry.sample_z_m, "surface_profiles: sample z");
-    const std::vector<double> b = frames.size() > 1
-                                      ? frames[k + 1].v_theta.row_at(geometry.sample_z_m, "surface_profiles: sample z")
-                                      : a;
+    const std::vector<double> b =
+        frames.size() > 1 ? frames[k + 1].v_theta.row_at(geometry.sample_z_m, "surface_profiles: sample z") : a;
     ShearProfile p;
     p.angle_rad = theta;
     p.time_s = t;
@@ -251,10 +250,11 @@ LinearFit front_speed(const std::vector<ShearFront>& fronts, const AnnularGeomet
   }
   const std::size_t min_points = std::max<std::size_t>(2, options.min_points);
   if (s.size() < min_points)
-    throw InputError(fmt::format("front_speed: only {} points to fit (at least {} needed): {} frames, front found "
-                                 "in {}, window [{}, {}] s{}",
-                                 s.size(), min_points, fronts.size(), found, options.t_begin_s, options.t_end_s,
-                                 std::isnan(cut) ? std::string() : fmt::format(", cut at the outer wall at t = {} s", cut)));
+    throw InputError(
+        fmt::format("front_speed: only {} points to fit (at least {} needed): {} frames, front found "
+                    "in {}, window [{}, {}] s{}",
+                    s.size(), min_points, fronts.size(), found, options.t_begin_s, options.t_end_s,
+                    std::isnan(cut) ? std::string() : fmt::format(", cut at the outer wall at t = {} s", cut)));
   s.validate("front_speed: front radius series", min_points);
   return fit_line(s.time, s.value, "front_speed");
 }
@@ -263,8 +263,8 @@ FlowStop flow_stop_time(const std::vector<ShearFrame>& frames, const AnnularGeom
                         double speed_tolerance_m_per_s, double wall_margin_m, double threshold) {
   check_frames(frames, geometry, "flow_stop_time");
   if (!(std::isfinite(speed_tolerance_m_per_s) && speed_tolerance_m_per_s >= 0.0))
-    throw InputError(fmt::format("flow_stop_time: speed tolerance = {} m/s must be finite and >= 0",
-                                 speed_tolerance_m_per_s));
+    throw InputError(
+        fmt::format("flow_stop_time: speed tolerance = {} m/s must be finite and >= 0", speed_tolerance_m_per_s));
   if (!(std::isfinite(wall_margin_m) && wall_margin_m >= 0.0))
     throw InputError(fmt::format("flow_stop_time: wall margin = {} m must be finite and >= 0", wall_margin_m));
   const std::vector<std::size_t> inner = gap_nodes(frames.front().v_theta, geometry, true);
@@ -353,16 +353,17 @@ CouetteLimit steady_couette_limit(const std::vector<double>& tau_Pa, const std::
                                   const AnnularGeometry& geometry) {
   const std::size_t n = tau_Pa.size();
   if (n < 2 || gamma_dot_1_s.size() != n)
-    throw InputError(fmt::format("steady_couette_limit: {} stresses and {} shear rates: need >= 2 of each, as many",
-                                 n, gamma_dot_1_s.size()));
+    throw InputError(fmt::format("steady_couette_limit: {} stresses and {} shear rates: need >= 2 of each, as many", n,
+                                 gamma_dot_1_s.size()));
   const double r0 = geometry.bob_radius_m, ro = geometry.outer_radius_m;
   const double span = 2.0 * log_radius_ratio(geometry, "steady_couette_limit");  // ln tau_0 - ln tau_wall
-  std::vector<double> u(n);  // ln tau
+  std::vector<double> u(n);                                                      // ln tau
   for (std::size_t k = 0; k < n; ++k) {
     if (!(std::isfinite(tau_Pa[k]) && tau_Pa[k] > 0.0 && (k == 0 || tau_Pa[k] > tau_Pa[k - 1])))
-      throw InputError(fmt::format("steady_couette_limit: stress sample {} = {} Pa: stresses must be positive and "
-                                   "strictly increasing",
-                                   k, tau_Pa[k]));
+      throw InputError(
+          fmt::format("steady_couette_limit: stress sample {} = {} Pa: stresses must be positive and "
+                      "strictly increasing",
+                      k, tau_Pa[k]));
     if (!(std::isfinite(gamma_dot_1_s[k]) && gamma_dot_1_s[k] >= 0.0))
       throw InputError(fmt::format("steady_couette_limit: shear rate sample {} = {} 1/s must be finite and >= 0", k,
                                    gamma_dot_1_s[k]));
@@ -370,10 +371,12 @@ CouetteLimit steady_couette_limit(const std::vector<double>& tau_Pa, const std::
   }
   // G(u) = (1/2) integral of gamma_dot du from u_0: exact for gamma_dot linear in u on each interval.
   std::vector<double> G(n, 0.0);
-  for (std::size_t k = 1; k < n; ++k) G[k] = G[k - 1] + 0.25 * (gamma_dot_1_s[k] + gamma_dot_1_s[k - 1]) * (u[k] - u[k - 1]);
+  for (std::size_t k = 1; k < n; ++k)
+    G[k] = G[k - 1] + 0.25 * (gamma_dot_1_s[k] + gamma_dot_1_s[k - 1]) * (u[k] - u[k - 1]);
   auto G_at = [&](double x) {  // u_0 <= x <= u_{n-1}
     const auto it = std::upper_bound(u.begin(), u.end(), x);
-    const std::size_t j = std::min<std::size_t>(static_cast<std::size_t>(std::max<std::ptrdiff_t>(it - u.begin(), 1)) - 1, n - 2);
+    const std::size_t j =
+        std::min<std::size_t>(static_cast<std::size_t>(std::max<std::ptrdiff_t>(it - u.begin(), 1)) - 1, n - 2);
     const double h = u[j + 1] - u[j], s = x - u[j];
     const double g0 = gamma_dot_1_s[j], g1 = gamma_dot_1_s[j + 1];
     return G[j] + 0.5 * (g0 * s + 0.5 * (g1 - g0) * s * s / h);
@@ -391,9 +394,10 @@ CouetteLimit steady_couette_limit(const std::vector<double>& tau_Pa, const std::
     }
   }
   if (!any)
-    throw InputError(fmt::format("steady_couette_limit: the samples span a factor {:.3g} in stress, less than the "
-                                 "gap's (r_o/r_0)^2 = {:.3g}",
-                                 tau_Pa.back() / tau_Pa.front(), (ro / r0) * (ro / r0)));
+    throw InputError(
+        fmt::format("steady_couette_limit: the samples span a factor {:.3g} in stress, less than the "
+                    "gap's (r_o/r_0)^2 = {:.3g}",
+                    tau_Pa.back() / tau_Pa.front(), (ro / r0) * (ro / r0)));
   return best;
 }
 

@@ -24,11 +24,11 @@ struct ShearFrame {
 };
 
 struct AnnularGeometry {
-  double bob_radius_m = 0.0125;       ///< r_0, the rotating inner cylinder
-  double outer_radius_m = 0.0485;     ///< r_o, the fixed outer wall
-  double bob_speed_m_per_s = 0.084;   ///< u_i, the bob's surface speed (omega_bob = u_i / r_0)
-  double sample_z_m = 0.0;            ///< height of the profile line (just below the free surface)
-  double start_time_s = 0.0;          ///< time the bob starts rotating (theta = 0)
+  double bob_radius_m = 0.0125;      ///< r_0, the rotating inner cylinder
+  double outer_radius_m = 0.0485;    ///< r_o, the fixed outer wall
+  double bob_speed_m_per_s = 0.084;  ///< u_i, the bob's surface speed (omega_bob = u_i / r_0)
+  double sample_z_m = 0.0;           ///< height of the profile line (just below the free surface)
+  double start_time_s = 0.0;         ///< time the bob starts rotating (theta = 0)
 };
 
 /// A radial profile of v_theta / u_i.
@@ -60,8 +60,8 @@ NewtonianAnnulus newtonian_annulus(double inner_radius_m, double inner_speed_m_p
 /// Normalised L2 distance of a profile v/u_i from the Newtonian one over its radial extent:
 /// sqrt( integral (v/u_i - v_N/u_i)^2 dr / (r_last - r_first) ), trapezoidal rule over the
 /// profile's points (dimensionless; 0 for an exact A r + B/r profile).
-double newtonian_distance(const std::vector<double>& r_m, const std::vector<double>& v_over_ui,
-                          double inner_radius_m, double outer_radius_m);
+double newtonian_distance(const std::vector<double>& r_m, const std::vector<double>& v_over_ui, double inner_radius_m,
+                          double outer_radius_m);
 double newtonian_distance(const ShearProfile& profile, const AnnularGeometry& geometry);
 
 /// Jammed-front radius in one frame: walking outward from the bob along z = sample_z_m, the
@@ -69,9 +69,9 @@ double newtonian_distance(const ShearProfile& profile, const AnnularGeometry& ge
 /// interpolated between nodes (at the bob the ratio is interpolated at r_0).
 struct ShearFront {
   double time_s = 0.0;
-  bool found = false;       ///< ratio >= threshold at the bob
-  bool at_wall = false;     ///< ratio >= threshold up to the outer wall: front placed there
-  double radius_m = 0.0;    ///< front radius (r_0 when not found)
+  bool found = false;     ///< ratio >= threshold at the bob
+  bool at_wall = false;   ///< ratio >= threshold up to the outer wall: front placed there
+  double radius_m = 0.0;  ///< front radius (r_0 when not found)
 };
 ShearFront jammed_front(const ShearFrame& frame, const AnnularGeometry& geometry, double threshold = 0.5);
 
@@ -126,10 +126,10 @@ TimeSeries outer_rotation_series(const std::vector<ShearFrame>& frames, const An
 /// and its time, and the first later time at which it has fallen below `fraction` of that peak
 /// (nullopt when it never does or the peak is <= 0). Whether it stays arrested: `final_value`.
 struct OuterArrest {
-  double peak = 0.0;                   ///< max of the outer rotation [-]
+  double peak = 0.0;  ///< max of the outer rotation [-]
   double peak_time_s = 0.0;
-  double final_value = 0.0;            ///< outer rotation in the last frame [-]
-  double fraction = 0.1;               ///< the criterion used
+  double final_value = 0.0;  ///< outer rotation in the last frame [-]
+  double fraction = 0.1;     ///< the criterion used
   std::optional<double> arrest_time_s;
 };
 OuterArrest outer_arrest(const TimeSeries& outer_rotation, double fraction = 0.1);

@@ -16,12 +16,12 @@ void GridField2D::validate(const std::string& what) const {
   if (nx < 2 || ny < 2)
     throw InputError(fmt::format("{}: grid must have at least 2 x 2 nodes, got {} x {}", what, nx, ny));
   if (values.size() != nx * ny)
-    throw InputError(fmt::format("{}: {} values for a {} x {} grid (expected nx * ny = {})", what,
-                                 values.size(), nx, ny, nx * ny));
+    throw InputError(
+        fmt::format("{}: {} values for a {} x {} grid (expected nx * ny = {})", what, values.size(), nx, ny, nx * ny));
   for (std::size_t k = 0; k < values.size(); ++k)
     if (!std::isfinite(values[k]))
-      throw InputError(fmt::format("{}: value at node (i = {}, j = {}) is not finite ({})", what,
-                                   k % nx, k / nx, values[k]));
+      throw InputError(
+          fmt::format("{}: value at node (i = {}, j = {}) is not finite ({})", what, k % nx, k / nx, values[k]));
 }
 
 namespace {
@@ -44,8 +44,7 @@ void bracket(double c, double origin, double h, std::size_t n, std::size_t& lo, 
 std::vector<double> GridField2D::row_at(double y_m, const std::string& what) const {
   const double tol = 1e-9 * h;
   if (!std::isfinite(y_m) || y_m < origin_y - tol || y_m > y_max() + tol)
-    throw InputError(fmt::format("{}: height y = {} m lies outside the grid [{}, {}] m", what, y_m,
-                                 origin_y, y_max()));
+    throw InputError(fmt::format("{}: height y = {} m lies outside the grid [{}, {}] m", what, y_m, origin_y, y_max()));
   std::size_t j = 0;
   double w = 0.0;
   bracket(y_m, origin_y, h, ny, j, w);
@@ -57,8 +56,8 @@ std::vector<double> GridField2D::row_at(double y_m, const std::string& what) con
 std::vector<double> GridField2D::column_at(double x_m, const std::string& what) const {
   const double tol = 1e-9 * h;
   if (!std::isfinite(x_m) || x_m < origin_x - tol || x_m > x_max() + tol)
-    throw InputError(fmt::format("{}: abscissa x = {} m lies outside the grid [{}, {}] m", what,
-                                 x_m, origin_x, x_max()));
+    throw InputError(
+        fmt::format("{}: abscissa x = {} m lies outside the grid [{}, {}] m", what, x_m, origin_x, x_max()));
   std::size_t i = 0;
   double w = 0.0;
   bracket(x_m, origin_x, h, nx, i, w);
@@ -69,24 +68,22 @@ std::vector<double> GridField2D::column_at(double x_m, const std::string& what) 
 
 void TimeSeries::validate(const std::string& what, std::size_t min_points) const {
   if (time.size() != value.size())
-    throw InputError(fmt::format("{}: {} times but {} values (sizes must match)", what,
-                                 time.size(), value.size()));
+    throw InputError(fmt::format("{}: {} times but {} values (sizes must match)", what, time.size(), value.size()));
   if (time.size() < min_points)
     throw InputError(fmt::format("{}: {} samples, at least {} needed", what, time.size(), min_points));
   for (std::size_t k = 0; k < time.size(); ++k) {
     if (!std::isfinite(time[k]) || !std::isfinite(value[k]))
-      throw InputError(fmt::format("{}: sample {} (t = {}, value = {}) is not finite", what, k,
-                                   time[k], value[k]));
+      throw InputError(fmt::format("{}: sample {} (t = {}, value = {}) is not finite", what, k, time[k], value[k]));
     if (k > 0 && !(time[k] > time[k - 1]))
-      throw InputError(fmt::format("{}: time must be strictly increasing, but t[{}] = {} s <= "
-                                   "t[{}] = {} s",
-                                   what, k, time[k], k - 1, time[k - 1]));
+      throw InputError(
+          fmt::format("{}: time must be strictly increasing, but t[{}] = {} s <= "
+                      "t[{}] = {} s",
+                      what, k, time[k], k - 1, time[k - 1]));
   }
 }
 
 LinearFit fit_line(const std::vector<double>& x, const std::vector<double>& y, const std::string& what) {
-  if (x.size() != y.size())
-    throw InputError(fmt::format("{}: {} x values but {} y values", what, x.size(), y.size()));
+  if (x.size() != y.size()) throw InputError(fmt::format("{}: {} x values but {} y values", what, x.size(), y.size()));
   const std::size_t n = x.size();
   if (n < 2) throw InputError(fmt::format("{}: {} points, a line needs at least 2", what, n));
   double mx = 0.0, my = 0.0;
@@ -142,10 +139,10 @@ LinearFit fit_line(const TimeSeries& series, double t_begin_s, double t_end_s, c
     throw InputError(fmt::format("{}: fit interval [{}, {}] s is empty", what, t_begin_s, t_end_s));
   const TimeSeries part = restrict_time(series, t_begin_s, t_end_s);
   if (part.size() < 2)
-    throw InputError(fmt::format("{}: only {} samples in the fit interval [{}, {}] s (series spans "
-                                 "[{}, {}] s); a line needs at least 2",
-                                 what, part.size(), t_begin_s, t_end_s, series.time.front(),
-                                 series.time.back()));
+    throw InputError(
+        fmt::format("{}: only {} samples in the fit interval [{}, {}] s (series spans "
+                    "[{}, {}] s); a line needs at least 2",
+                    what, part.size(), t_begin_s, t_end_s, series.time.front(), series.time.back()));
   return fit_line(part.time, part.value, what);
 }
 

@@ -18,11 +18,11 @@ namespace oobleck::analysis {
 
 /// Nodal values on a uniform 2D grid (see the conventions above).
 struct GridField2D {
-  double origin_x = 0.0;  ///< x (or r) of node i = 0 [m]
-  double origin_y = 0.0;  ///< y (or z) of node j = 0 [m]
-  double h = 0.0;         ///< node spacing [m], same along both axes
-  std::size_t nx = 0;     ///< nodes along x (r)
-  std::size_t ny = 0;     ///< nodes along y (z)
+  double origin_x = 0.0;       ///< x (or r) of node i = 0 [m]
+  double origin_y = 0.0;       ///< y (or z) of node j = 0 [m]
+  double h = 0.0;              ///< node spacing [m], same along both axes
+  std::size_t nx = 0;          ///< nodes along x (r)
+  std::size_t ny = 0;          ///< nodes along y (z)
   std::vector<double> values;  ///< nx * ny values, row-major (index j * nx + i)
 
   double x(std::size_t i) const { return origin_x + static_cast<double>(i) * h; }
@@ -68,11 +68,9 @@ struct LinearFit {
 
 /// Least-squares straight line through (x[k], y[k]). Needs >= 2 points with distinct x; with
 /// exactly 2 points the standard errors are 0 (no residual degrees of freedom) and r_squared 1.
-LinearFit fit_line(const std::vector<double>& x, const std::vector<double>& y,
-                   const std::string& what = "fit_line");
+LinearFit fit_line(const std::vector<double>& x, const std::vector<double>& y, const std::string& what = "fit_line");
 /// fit_line on series.time, series.value restricted to t_begin <= t <= t_end [s].
-LinearFit fit_line(const TimeSeries& series, double t_begin_s, double t_end_s,
-                   const std::string& what = "fit_line");
+LinearFit fit_line(const TimeSeries& series, double t_begin_s, double t_end_s, const std::string& what = "fit_line");
 /// fit_line on the whole series.
 LinearFit fit_line(const TimeSeries& series, const std::string& what = "fit_line");
 

@@ -14,8 +14,7 @@ namespace oobleck::analysis {
 FrontCriterion velocity_front(double v0_m_per_s, double fraction) {
   if (!(std::isfinite(v0_m_per_s) && v0_m_per_s != 0.0))
     throw InputError(fmt::format("velocity_front: v_0 = {} m/s must be finite and non-zero", v0_m_per_s));
-  if (!std::isfinite(fraction))
-    throw InputError(fmt::format("velocity_front: fraction = {} must be finite", fraction));
+  if (!std::isfinite(fraction)) throw InputError(fmt::format("velocity_front: fraction = {} must be finite", fraction));
   return FrontCriterion{v0_m_per_s, fraction};
 }
 
@@ -29,32 +28,35 @@ namespace {
 
 void check_criterion(const FrontCriterion& c, const char* what) {
   if (!(std::isfinite(c.scale) && c.scale != 0.0))
-    throw InputError(fmt::format("{}: criterion scale = {} must be finite and non-zero (v_0 for u_z, "
-                                 "1 for f)",
-                                 what, c.scale));
+    throw InputError(
+        fmt::format("{}: criterion scale = {} must be finite and non-zero (v_0 for u_z, "
+                    "1 for f)",
+                    what, c.scale));
   if (!std::isfinite(c.threshold))
     throw InputError(fmt::format("{}: criterion threshold = {} must be finite", what, c.threshold));
 }
 
 void check_geometry(const FrontGeometry& g, const GridField2D& field, const char* what) {
   if (g.direction != 1.0 && g.direction != -1.0)
-    throw InputError(fmt::format("{}: direction = {} must be +1 or -1 (sign of the intruder's "
-                                 "motion along z)",
-                                 what, g.direction));
+    throw InputError(
+        fmt::format("{}: direction = {} must be +1 or -1 (sign of the intruder's "
+                    "motion along z)",
+                    what, g.direction));
   const double tol = 1e-9 * field.h;
   if (!std::isfinite(g.intruder_radius_m) || g.intruder_radius_m < field.origin_x - tol ||
       g.intruder_radius_m > field.x_max() + tol)
-    throw InputError(fmt::format("{}: intruder radius R = {} m lies outside the grid's r range "
-                                 "[{}, {}] m",
-                                 what, g.intruder_radius_m, field.origin_x, field.x_max()));
+    throw InputError(
+        fmt::format("{}: intruder radius R = {} m lies outside the grid's r range "
+                    "[{}, {}] m",
+                    what, g.intruder_radius_m, field.origin_x, field.x_max()));
   if (!std::isfinite(g.axis_r_m) || g.axis_r_m < field.origin_x - tol || g.axis_r_m > field.x_max() + tol)
-    throw InputError(fmt::format("{}: axis column r = {} m lies outside the grid's r range [{}, {}] m",
-                                 what, g.axis_r_m, field.origin_x, field.x_max()));
+    throw InputError(fmt::format("{}: axis column r = {} m lies outside the grid's r range [{}, {}] m", what,
+                                 g.axis_r_m, field.origin_x, field.x_max()));
   if (!std::isfinite(g.transverse_offset_m))
     throw InputError(fmt::format("{}: transverse offset = {} m must be finite", what, g.transverse_offset_m));
   if (!(std::isfinite(g.tip_gap_m) && g.tip_gap_m >= 0.0) || !(std::isfinite(g.edge_gap_m) && g.edge_gap_m >= 0.0))
-    throw InputError(fmt::format("{}: tip gap = {} m and edge gap = {} m must be finite and >= 0", what, g.tip_gap_m,
-                                 g.edge_gap_m));
+    throw InputError(
+        fmt::format("{}: tip gap = {} m and edge gap = {} m must be finite and >= 0", what, g.tip_gap_m, g.edge_gap_m));
 }
 
 bool same_grid(const GridField2D& a, const GridField2D& b) {
@@ -126,23 +128,26 @@ FrontPosition measure_front(const GridField2D& field, double tip_z_m, const Fron
 std::vector<IntrusionFrame> time_filter(const std::vector<IntrusionFrame>& frames, std::size_t window_frames) {
   if (frames.empty()) throw InputError("time_filter: no frames");
   if (window_frames == 0 || window_frames % 2 == 0)
-    throw InputError(fmt::format("time_filter: window = {} frames must be odd and >= 1 (centered "
-                                 "moving average; 1 = no filtering)",
-                                 window_frames));
+    throw InputError(
+        fmt::format("time_filter: window = {} frames must be odd and >= 1 (centered "
+                    "moving average; 1 = no filtering)",
+                    window_frames));
   for (std::size_t k = 0; k < frames.size(); ++k) {
     frames[k].field.validate(fmt::format("time_filter: frame {} field", k));
     if (!std::isfinite(frames[k].time_s) || !std::isfinite(frames[k].tip_z_m))
       throw InputError(fmt::format("time_filter: frame {} has a non-finite time ({}) or tip z ({})", k,
                                    frames[k].time_s, frames[k].tip_z_m));
     if (k > 0 && !(frames[k].time_s > frames[k - 1].time_s))
-      throw InputError(fmt::format("time_filter: frame times must be strictly increasing, but t[{}] = {} "
-                                   "s <= t[{}] = {} s",
-                                   k, frames[k].time_s, k - 1, frames[k - 1].time_s));
+      throw InputError(
+          fmt::format("time_filter: frame times must be strictly increasing, but t[{}] = {} "
+                      "s <= t[{}] = {} s",
+                      k, frames[k].time_s, k - 1, frames[k - 1].time_s));
     if (!same_grid(frames[k].field, frames[0].field))
-      throw InputError(fmt::format("time_filter: frame {} is on a different grid than frame 0 ({} x {} "
-                                   "nodes, h = {} m vs {} x {}, h = {} m)",
-                                   k, frames[k].field.nx, frames[k].field.ny, frames[k].field.h,
-                                   frames[0].field.nx, frames[0].field.ny, frames[0].field.h));
+      throw InputError(
+          fmt::format("time_filter: frame {} is on a different grid than frame 0 ({} x {} "
+                      "nodes, h = {} m vs {} x {}, h = {} m)",
+                      k, frames[k].field.nx, frames[k].field.ny, frames[k].field.h, frames[0].field.nx,
+                      frames[0].field.ny, frames[0].field.h));
   }
   if (window_frames == 1) return frames;
   const std::size_t half = window_frames / 2;
@@ -209,8 +214,7 @@ FrontSeries measure_front_series(const std::vector<IntrusionFrame>& frames, cons
   return out;
 }
 
-FrontSpeeds front_factors(const LinearFit& longitudinal_depth_fit, const LinearFit& transverse_fit,
-                          double v0_m_per_s) {
+FrontSpeeds front_factors(const LinearFit& longitudinal_depth_fit, const LinearFit& transverse_fit, double v0_m_per_s) {
   if (!(std::isfinite(v0_m_per_s) && v0_m_per_s != 0.0))
     throw InputError(fmt::format("front_factors: v_0 = {} m/s must be finite and non-zero", v0_m_per_s));
   FrontSpeeds s;
@@ -241,8 +245,7 @@ FrontSpeeds front_factors(const LinearFit& longitudinal_depth_fit, const LinearF
 namespace {
 // The frames of one front entering its fit: found, inside [t_begin, t_end], and before the first
 // frame (inside the window) whose front reached the grid's end or came within margin of the wall.
-TimeSeries fit_points(const FrontSeries& series, bool longitudinal, const FrontFitOptions& o,
-                      std::string& why) {
+TimeSeries fit_points(const FrontSeries& series, bool longitudinal, const FrontFitOptions& o, std::string& why) {
   TimeSeries out;
   std::size_t found = 0, in_window = 0;
   double cut_time = std::numeric_limits<double>::quiet_NaN();
@@ -263,8 +266,8 @@ TimeSeries fit_points(const FrontSeries& series, bool longitudinal, const FrontF
     out.value.push_back(longitudinal ? series.direction * (p.longitudinal_z_m - series.reference_z_m)
                                      : p.transverse_r_m);
   }
-  why = fmt::format("{} frames, front found in {}, {} inside [{}, {}] s{}", series.frames.size(), found,
-                    in_window, o.t_begin_s, o.t_end_s,
+  why = fmt::format("{} frames, front found in {}, {} inside [{}, {}] s{}", series.frames.size(), found, in_window,
+                    o.t_begin_s, o.t_end_s,
                     std::isnan(cut_time) ? std::string()
                                          : fmt::format(", cut at t = {} s where the front came within {} m "
                                                        "of the wall",
@@ -284,13 +287,15 @@ FrontSpeeds front_speeds(const FrontSeries& series, double v0_m_per_s, const Fro
   const TimeSeries l = fit_points(series, true, options, why_l);
   const TimeSeries t = fit_points(series, false, options, why_t);
   if (l.size() < min_points)
-    throw InputError(fmt::format("front_speeds: only {} points for the longitudinal front fit (at least "
-                                 "{} needed): {}",
-                                 l.size(), min_points, why_l));
+    throw InputError(
+        fmt::format("front_speeds: only {} points for the longitudinal front fit (at least "
+                    "{} needed): {}",
+                    l.size(), min_points, why_l));
   if (t.size() < min_points)
-    throw InputError(fmt::format("front_speeds: only {} points for the transverse front fit (at least {} "
-                                 "needed): {}",
-                                 t.size(), min_points, why_t));
+    throw InputError(
+        fmt::format("front_speeds: only {} points for the transverse front fit (at least {} "
+                    "needed): {}",
+                    t.size(), min_points, why_t));
   l.validate("front_speeds: longitudinal front series", min_points);
   t.validate("front_speeds: transverse front series", min_points);
   FrontSpeeds s = front_factors(fit_line(l.time, l.value, "front_speeds: longitudinal fit"),

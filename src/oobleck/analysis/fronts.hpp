@@ -101,15 +101,14 @@ struct IntrusionFrame {
 /// both ends (so the first and last w/2 frames average fewer frames). Times and tip positions
 /// are unchanged. Models the finite frame rate / exposure of the experiments' imaging. Throws
 /// InputError for an even or zero window, non-increasing times or fields on different grids.
-std::vector<IntrusionFrame> time_filter(const std::vector<IntrusionFrame>& frames,
-                                        std::size_t window_frames);
+std::vector<IntrusionFrame> time_filter(const std::vector<IntrusionFrame>& frames, std::size_t window_frames);
 
 /// Front positions through a run.
 struct FrontSeries {
   std::vector<FrontPosition> frames;
-  double reference_z_m = 0.0;       ///< z_ref of the lab-frame depth (first tip z by default)
-  double direction = -1.0;          ///< copied from the geometry
-  double intruder_radius_m = 0.0;   ///< copied from the geometry
+  double reference_z_m = 0.0;          ///< z_ref of the lab-frame depth (first tip z by default)
+  double direction = -1.0;             ///< copied from the geometry
+  double intruder_radius_m = 0.0;      ///< copied from the geometry
   double longitudinal_wall_z_m = 0.0;  ///< grid end in the direction of motion [m]
   double transverse_wall_r_m = 0.0;    ///< outer radius of the grid [m]
 
@@ -142,23 +141,22 @@ struct FrontFitOptions {
 
 /// Front speeds and the paper's propagation factors.
 struct FrontSpeeds {
-  LinearFit longitudinal;  ///< lab-frame depth [m] vs t [s]: slope = v_fl
-  LinearFit transverse;    ///< r_front [m] vs t [s]: slope = v_ft
+  LinearFit longitudinal;                                           ///< lab-frame depth [m] vs t [s]: slope = v_fl
+  LinearFit transverse;                                             ///< r_front [m] vs t [s]: slope = v_ft
   double longitudinal_t_begin_s = 0.0, longitudinal_t_end_s = 0.0;  ///< fitted interval
   double transverse_t_begin_s = 0.0, transverse_t_end_s = 0.0;      ///< fitted interval
-  double v0_m_per_s = 0.0;       ///< |v_0|
+  double v0_m_per_s = 0.0;                                          ///< |v_0|
   double v_fl_m_per_s = 0.0, v_fl_stderr_m_per_s = 0.0;
   double v_ft_m_per_s = 0.0, v_ft_stderr_m_per_s = 0.0;
-  double k_l = 0.0, k_l_stderr = 0.0;  ///< v_fl / v_0 - 1
-  double k_t = 0.0, k_t_stderr = 0.0;  ///< v_ft / v_0
+  double k_l = 0.0, k_l_stderr = 0.0;      ///< v_fl / v_0 - 1
+  double k_t = 0.0, k_t_stderr = 0.0;      ///< v_ft / v_0
   double ratio = 0.0, ratio_stderr = 0.0;  ///< k_l / k_t (NaN when k_t = 0)
 };
 
 /// k_l, k_t and k_l/k_t from the two fits (slopes in m/s) and |v_0|. The standard errors are
 /// propagated to first order, treating the two fits as independent and v_0 as exact:
 /// s(k_l) = s(v_fl)/v_0, s(k_t) = s(v_ft)/v_0, s(k_l/k_t)^2 = (s(k_l)/k_t)^2 + (k_l s(k_t)/k_t^2)^2.
-FrontSpeeds front_factors(const LinearFit& longitudinal_depth_fit, const LinearFit& transverse_fit,
-                          double v0_m_per_s);
+FrontSpeeds front_factors(const LinearFit& longitudinal_depth_fit, const LinearFit& transverse_fit, double v0_m_per_s);
 
 /// Fit the fronts of `series` (lab-frame depth and r_front vs time) over the interval and wall
 /// cut of `options`, then front_factors. Throws InputError when a fit has fewer than

@@ -14,8 +14,8 @@ double sample_line(const std::vector<double>& values, double origin, double h, d
 
 /// Result of a threshold search along a line.
 struct LineCrossing {
-  bool found = false;   ///< g >= threshold somewhere on the line (contiguous: at the start)
-  bool at_end = false;  ///< g >= threshold up to the last node: front placed there
+  bool found = false;     ///< g >= threshold somewhere on the line (contiguous: at the start)
+  bool at_end = false;    ///< g >= threshold up to the last node: front placed there
   double position = 0.0;  ///< search coordinate of the front
 };
 

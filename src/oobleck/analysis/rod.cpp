@@ -12,8 +12,8 @@ namespace oobleck::analysis {
 namespace {
 void check_direction(double direction, const char* what) {
   if (direction != 1.0 && direction != -1.0)
-    throw InputError(fmt::format("{}: direction = {} must be +1 or -1 (sign of the rod's motion along z)",
-                                 what, direction));
+    throw InputError(
+        fmt::format("{}: direction = {} must be +1 or -1 (sign of the rod's motion along z)", what, direction));
 }
 }  // namespace
 
@@ -112,9 +112,10 @@ DepthProfile displacement_below_rod(const GridField2D& uz_m, double z_start_m, d
     throw InputError(fmt::format("displacement_below_rod: surface z = {} m must be finite", z_surface_m));
   const double end = std::isnan(z_end_m) ? (direction < 0 ? uz_m.origin_y : uz_m.y_max()) : z_end_m;
   if (!std::isfinite(end) || !(direction * (end - z_start_m) > 0.0))
-    throw InputError(fmt::format("displacement_below_rod: end z = {} m must lie beyond the start z = {} m "
-                                 "in the direction of motion ({})",
-                                 end, z_start_m, direction));
+    throw InputError(
+        fmt::format("displacement_below_rod: end z = {} m must lie beyond the start z = {} m "
+                    "in the direction of motion ({})",
+                    end, z_start_m, direction));
   const std::vector<double> column = uz_m.column_at(axis_r_m, "displacement_below_rod: axis column");
   DepthProfile p;
   p.depth_m.push_back(direction * (z_start_m - z_surface_m));
@@ -130,8 +131,8 @@ DepthProfile displacement_below_rod(const GridField2D& uz_m, double z_start_m, d
     }
   }
   if (p.depth_m.size() < 2)
-    throw InputError(fmt::format("displacement_below_rod: fewer than 2 samples between z = {} m and z = {} m",
-                                 z_start_m, end));
+    throw InputError(
+        fmt::format("displacement_below_rod: fewer than 2 samples between z = {} m and z = {} m", z_start_m, end));
   p.fit = fit_line(p.depth_m, p.displacement_m, "displacement_below_rod: |dz| vs depth fit");
   return p;
 }

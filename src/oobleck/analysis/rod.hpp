@@ -62,8 +62,7 @@ std::optional<double> impact_time_from_force(const TimeSeries& force_N, double t
 
 /// First contact from the position of the rod's tip: the first time direction * (z_tip -
 /// z_surface) >= 0, linearly interpolated between samples. nullopt if it never reaches it.
-std::optional<double> impact_time_from_position(const TimeSeries& tip_z_m, double surface_z_m,
-                                                double direction = -1.0);
+std::optional<double> impact_time_from_position(const TimeSeries& tip_z_m, double surface_z_m, double direction = -1.0);
 
 /// |dz| vs depth directly below the rod (Fig. 7c).
 struct DepthProfile {

@@ -22,7 +22,9 @@ nlohmann::json to_json(const LinearFit& fit) {
           {"points", fit.points}};
 }
 
-nlohmann::json to_json(const TimeSeries& series) { return {{"time", nums(series.time)}, {"value", nums(series.value)}}; }
+nlohmann::json to_json(const TimeSeries& series) {
+  return {{"time", nums(series.time)}, {"value", nums(series.value)}};
+}
 
 nlohmann::json to_json(const FrontSpeeds& s) {
   nlohmann::json l = to_json(s.longitudinal);
@@ -78,7 +80,8 @@ nlohmann::json to_json(const DepthProfile& p) {
 nlohmann::json to_json(const std::vector<ShearProfile>& profiles) {
   nlohmann::json a = nlohmann::json::array();
   for (const ShearProfile& p : profiles)
-    a.push_back({{"angle", num(p.angle_rad)}, {"time", num(p.time_s)}, {"r", nums(p.r_m)}, {"v_over_ui", nums(p.v_over_ui)}});
+    a.push_back(
+        {{"angle", num(p.angle_rad)}, {"time", num(p.time_s)}, {"r", nums(p.r_m)}, {"v_over_ui", nums(p.v_over_ui)}});
   return a;
 }
 

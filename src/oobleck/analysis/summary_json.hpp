@@ -20,7 +20,8 @@ nlohmann::json to_json(const TimeSeries& series);
 /// {v0, v_fl, v_fl_stderr, v_ft, v_ft_stderr, k_l, k_l_stderr, k_t, k_t_stderr, k_l_over_k_t,
 ///  k_l_over_k_t_stderr, longitudinal_fit: {..., t_begin, t_end}, transverse_fit: {...}}
 nlohmann::json to_json(const FrontSpeeds& speeds);
-/// {time, tip_z, longitudinal: {found, at_boundary, z, ahead}, transverse: {found, at_boundary, r, from_edge}} per frame
+/// {time, tip_z, longitudinal: {found, at_boundary, z, ahead}, transverse: {found, at_boundary, r, from_edge}} per
+/// frame
 nlohmann::json to_json(const FrontSeries& series);
 /// {peak_deceleration [m/s^2], peak_deceleration_time [s]}
 nlohmann::json to_json(const PeakDeceleration& peak);

@@ -77,8 +77,8 @@ SurfaceProfile free_surface(const GridField2D& phi, double phi_threshold) {
       if (phi.at(i, j) >= phi_threshold) {
         p.has_material[i] = true;
         p.height_m[i] = (j + 1 == phi.ny) ? phi.y(j)
-                                          : interpolate_crossing(phi.y(j), phi.at(i, j), phi.y(j + 1),
-                                                                 phi.at(i, j + 1), phi_threshold);
+                                          : interpolate_crossing(phi.y(j), phi.at(i, j), phi.y(j + 1), phi.at(i, j + 1),
+                                                                 phi_threshold);
         break;
       }
     }
@@ -96,8 +96,8 @@ void finish_scatter(PressureScatter& r, double dev2, double p2) {
 }
 }  // namespace
 
-PressureScatter pressure_scatter(std::span<const double> x_m, std::span<const double> y_m,
-                                 std::span<const double> p_Pa, const ScatterWindow& w) {
+PressureScatter pressure_scatter(std::span<const double> x_m, std::span<const double> y_m, std::span<const double> p_Pa,
+                                 const ScatterWindow& w) {
   if (x_m.size() != y_m.size() || x_m.size() != p_Pa.size())
     throw InputError(fmt::format("pressure_scatter: {} x, {} y and {} pressure values differ in number", x_m.size(),
                                  y_m.size(), p_Pa.size()));

@@ -32,18 +32,18 @@ struct WheelCriteria {
 };
 
 struct WheelSummary {
-  double duration_s = 0.0;                ///< t_last - t_first
+  double duration_s = 0.0;  ///< t_last - t_first
   double hub_height_initial_m = 0.0;
   double hub_height_final_m = 0.0;
   double hub_height_min_m = 0.0;
   double hub_height_min_time_s = 0.0;
-  double height_loss_m = 0.0;             ///< initial - final
-  double distance_m = 0.0;                ///< forward * (x_unwrapped_last - x_unwrapped_first)
+  double height_loss_m = 0.0;               ///< initial - final
+  double distance_m = 0.0;                  ///< forward * (x_unwrapped_last - x_unwrapped_first)
   double mean_forward_speed_m_per_s = 0.0;  ///< distance / duration
-  bool stays_at_surface = false;  ///< height_loss < wheel radius and distance > 0
-  bool sinks = false;             ///< final hub height below the initial bed surface
-  bool ever_below_surface = false;  ///< minimum hub height below the initial bed surface
-  std::vector<double> x_unwrapped_m;  ///< unwrapped hub x for every sample
+  bool stays_at_surface = false;            ///< height_loss < wheel radius and distance > 0
+  bool sinks = false;                       ///< final hub height below the initial bed surface
+  bool ever_below_surface = false;          ///< minimum hub height below the initial bed surface
+  std::vector<double> x_unwrapped_m;        ///< unwrapped hub x for every sample
 };
 
 /// Summarise a hub track (>= 2 samples, strictly increasing times, equal sizes).
@@ -87,8 +87,8 @@ struct PressureScatter {
   std::int64_t points = 0;  ///< counted points (in the window, sharing their cell with another)
   std::int64_t cells = 0;   ///< cells with two or more points in the window
 };
-PressureScatter pressure_scatter(std::span<const double> x_m, std::span<const double> y_m,
-                                 std::span<const double> p_Pa, const ScatterWindow& window);
+PressureScatter pressure_scatter(std::span<const double> x_m, std::span<const double> y_m, std::span<const double> p_Pa,
+                                 const ScatterWindow& window);
 
 /// Several samples pooled: rms_deviation = sqrt(Σ n_k rms_deviation_k² / Σ n_k), rms likewise,
 /// relative their ratio, points and cells summed (samples with no points are skipped).

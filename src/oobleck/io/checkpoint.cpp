@@ -47,7 +47,8 @@ bool plain_name(const std::string& name, bool allow_slash) {
 
 void check_attribute_name(const std::string& name) {
   if (!plain_name(name, false)) {
-    throw std::invalid_argument(fmt::format("checkpoint attribute name '{}': use letters, digits, '_', '-', '.'", name));
+    throw std::invalid_argument(
+        fmt::format("checkpoint attribute name '{}': use letters, digits, '_', '-', '.'", name));
   }
 }
 
@@ -130,10 +131,11 @@ void write_array(CheckpointWriter::Impl& impl, const std::string& path, const st
   impl.names.insert(name);
   std::vector<hsize_t> dims(shape.begin(), shape.end());
   h5::Handle space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr));
-  h5::Handle dset(H5Dcreate2(impl.arrays.get(), name.c_str(), type, space.get(), impl.lcpl.get(), H5P_DEFAULT,
-                             H5P_DEFAULT));
+  h5::Handle dset(
+      H5Dcreate2(impl.arrays.get(), name.c_str(), type, space.get(), impl.lcpl.get(), H5P_DEFAULT, H5P_DEFAULT));
   if (!dset.valid() || (count > 0 && H5Dwrite(dset.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0)) {
-    throw std::runtime_error(fmt::format("checkpoint '{}': cannot write array '{}' ({})", path, name, h5::last_error()));
+    throw std::runtime_error(
+        fmt::format("checkpoint '{}': cannot write array '{}' ({})", path, name, h5::last_error()));
   }
   h5::write_attribute(dset.get(), "checksum", as_int64(fnv1a(data.data(), data.size_bytes())));
   impl.name_list += name + "\n";
@@ -335,7 +337,8 @@ Checkpoint read_checkpoint(const std::string& path) {
     if (!h5::read_attribute(dset.get(), "checksum", stored)) {
       throw fail(fmt::format("dataset '/arrays/{}' has no checksum", name));
     }
-    if (stored != as_int64(sum)) throw fail(fmt::format("dataset '/arrays/{}' fails its checksum (corrupt data)", name));
+    if (stored != as_int64(sum))
+      throw fail(fmt::format("dataset '/arrays/{}' fails its checksum (corrupt data)", name));
     cp.arrays_.emplace(name, std::move(a));
   }
   return cp;

@@ -65,8 +65,8 @@ CsvTable read_csv(const std::string& path) {
       continue;
     }
     if (cells.size() != t.header.size()) {
-      throw InputError(fmt::format("{}:{}: {} values but the header has {} columns", path, lineno, cells.size(),
-                                   t.header.size()));
+      throw InputError(
+          fmt::format("{}:{}: {} values but the header has {} columns", path, lineno, cells.size(), t.header.size()));
     }
     std::vector<double> row;
     for (std::size_t j = 0; j < cells.size(); ++j) {

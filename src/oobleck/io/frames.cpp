@@ -46,8 +46,7 @@ bool is_plain_name(const std::string& name) {
 namespace {
 
 void check_name(const std::string& name, const char* what) {
-  if (!is_plain_name(name))
-    throw std::invalid_argument(fmt::format("{} name '{}': {}", what, name, kPlainNameRule));
+  if (!is_plain_name(name)) throw std::invalid_argument(fmt::format("{} name '{}': {}", what, name, kPlainNameRule));
 }
 
 std::vector<std::span<const double>> spans(std::initializer_list<std::span<const double>> list) {
@@ -112,7 +111,8 @@ void write_field(hid_t loc, const std::string& h5_prefix, const FieldView& f, st
 void check_fields(const FieldSet& set, const char* owner) {
   std::set<std::string> seen;
   for (const auto& f : set.fields()) {
-    if (!seen.insert(f.name).second) throw std::invalid_argument(fmt::format("{}: field '{}' given twice", owner, f.name));
+    if (!seen.insert(f.name).second)
+      throw std::invalid_argument(fmt::format("{}: field '{}' given twice", owner, f.name));
   }
 }
 
@@ -218,7 +218,8 @@ PointCloud::PointCloud(std::string name, std::initializer_list<std::span<const d
     throw std::invalid_argument(fmt::format("body '{}': {} position spans, expected 2 or 3", name_, dim_));
   }
   for (const auto& p : positions_) {
-    if (p.size() != count_) throw std::invalid_argument(fmt::format("body '{}': position spans differ in length", name_));
+    if (p.size() != count_)
+      throw std::invalid_argument(fmt::format("body '{}': position spans differ in length", name_));
   }
 }
 
@@ -239,7 +240,8 @@ NodeGrid::NodeGrid(int dim, std::array<double, 3> origin, std::array<double, 3> 
 // ---------------------------------------------------------------------------------------------
 // FrameWriter
 
-FrameWriter::FrameWriter(std::string run_dir, std::string name) : FrameWriter(std::move(run_dir), std::move(name), true) {}
+FrameWriter::FrameWriter(std::string run_dir, std::string name)
+    : FrameWriter(std::move(run_dir), std::move(name), true) {}
 
 FrameWriter::FrameWriter(std::string run_dir, std::string name, bool fresh)
     : run_dir_(std::move(run_dir)), name_(std::move(name)) {
@@ -338,7 +340,8 @@ std::string write_body_block(hid_t bodies, const PointCloud& b, const std::strin
   xml += time_xml;
   xml += fmt::format("      <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"{}\" NodesPerElement=\"1\">\n", n);
   xml += fmt::format(
-      "        <DataItem Dimensions=\"{}\" NumberType=\"Int\" Precision=\"{}\" Format=\"HDF\">{}/connectivity</DataItem>\n",
+      "        <DataItem Dimensions=\"{}\" NumberType=\"Int\" Precision=\"{}\" "
+      "Format=\"HDF\">{}/connectivity</DataItem>\n",
       n, small ? 4 : 8, prefix);
   xml += "      </Topology>\n";
   xml += fmt::format("      <Geometry GeometryType=\"{}\">\n", b.dim() == 2 ? "XY" : "XYZ");
@@ -358,9 +361,9 @@ std::string write_grid_block(hid_t file, const NodeGrid& grid, const std::string
   const auto& nn = grid.nodes();
   h5::write_attribute(g.get(), "origin", std::vector<double>{o[0], o[1], o[2]});
   h5::write_attribute(g.get(), "spacing", std::vector<double>{h[0], h[1], h[2]});
-  h5::write_attribute(g.get(), "nodes", std::vector<std::int64_t>{static_cast<std::int64_t>(nn[0]),
-                                                                  static_cast<std::int64_t>(nn[1]),
-                                                                  static_cast<std::int64_t>(nn[2])});
+  h5::write_attribute(g.get(), "nodes",
+                      std::vector<std::int64_t>{static_cast<std::int64_t>(nn[0]), static_cast<std::int64_t>(nn[1]),
+                                                static_cast<std::int64_t>(nn[2])});
   h5::write_attribute(g.get(), "dim", static_cast<std::int64_t>(grid.dim()));
   // A 2D grid is written as one layer of a 3D mesh: VTK's XDMF readers place a
   // 2DCoRectMesh in the y-z plane, away from the XY points; a 3DCoRectMesh with nz = 1

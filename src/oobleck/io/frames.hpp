@@ -117,8 +117,7 @@ class PointCloud : public FieldSet {
 /// fields are indexed i + nx (j + ny k) (x fastest). In 2D nodes[2] must be 1.
 class NodeGrid : public FieldSet {
  public:
-  NodeGrid(int dim, std::array<double, 3> origin, std::array<double, 3> spacing,
-           std::array<std::size_t, 3> nodes);
+  NodeGrid(int dim, std::array<double, 3> origin, std::array<double, 3> spacing, std::array<std::size_t, 3> nodes);
   int dim() const { return dim_; }
   const std::array<double, 3>& origin() const { return origin_; }
   const std::array<double, 3>& spacing() const { return spacing_; }
@@ -192,7 +191,7 @@ class FrameWriter {
   std::vector<Entry> entries_;
   bool index_stale_ = false;
   std::size_t index_bytes_ = 0;
-  double index_seconds_ = 0.0;                          // duration of the last rewrite
+  double index_seconds_ = 0.0;                           // duration of the last rewrite
   std::chrono::steady_clock::time_point index_written_;  // when it ended
 };
 

@@ -19,15 +19,15 @@ void check_writable(const std::string& path, const std::string& option) {
   if (dir.empty()) dir = ".";
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) {
-    throw InputError(fmt::format("{} '{}': cannot write output: folder '{}' does not exist", option, path,
-                                 dir.string()));
+    throw InputError(
+        fmt::format("{} '{}': cannot write output: folder '{}' does not exist", option, path, dir.string()));
   }
   if (fs::is_directory(p, ec)) {
     throw InputError(fmt::format("{} '{}': cannot write output: it is a folder", option, path));
   }
   if (::access(dir.c_str(), W_OK) != 0) {
-    throw InputError(fmt::format("{} '{}': cannot write output: folder '{}' is not writable ({})", option,
-                                 path, dir.string(), std::strerror(errno)));
+    throw InputError(fmt::format("{} '{}': cannot write output: folder '{}' is not writable ({})", option, path,
+                                 dir.string(), std::strerror(errno)));
   }
   if (fs::exists(p, ec) && ::access(p.c_str(), W_OK) != 0) {
     throw InputError(fmt::format("{} '{}': cannot write output: file is not writable", option, path));

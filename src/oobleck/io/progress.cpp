@@ -43,9 +43,7 @@ Progress::~Progress() {
   if (!finished_) finish();
 }
 
-double Progress::elapsed_seconds() const {
-  return std::chrono::duration<double>(Clock::now() - start_).count();
-}
+double Progress::elapsed_seconds() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
 
 std::string Progress::status_text(std::uint64_t done, double sim_time, double elapsed) const {
   const double frac = total_ > 0 ? static_cast<double>(done) / static_cast<double>(total_) : 1.0;
@@ -69,8 +67,9 @@ void Progress::emit(std::uint64_t done, double sim_time, double elapsed, bool fi
     constexpr int width = 28;
     const double frac = total_ > 0 ? std::min(1.0, static_cast<double>(done) / static_cast<double>(total_)) : 1.0;
     const int filled = static_cast<int>(frac * width);
-    line = fmt::format("{} [{}{}] {}", opt_.label, std::string(static_cast<std::size_t>(filled), '#'),
-                       std::string(static_cast<std::size_t>(width - filled), '.'), status_text(done, sim_time, elapsed));
+    line =
+        fmt::format("{} [{}{}] {}", opt_.label, std::string(static_cast<std::size_t>(filled), '#'),
+                    std::string(static_cast<std::size_t>(width - filled), '.'), status_text(done, sim_time, elapsed));
   } else {
     line = fmt::format("{}: {}", opt_.label, status_text(done, sim_time, elapsed));
   }

@@ -17,12 +17,12 @@ namespace oobleck::io {
 enum class ProgressMode { bar, lines, silent };
 
 struct ProgressOptions {
-  bool quiet = false;                 ///< --quiet: silent whatever the terminal
-  double line_interval_s = 10.0;      ///< seconds between lines in `lines` mode
-  double points_per_step = 0.0;       ///< > 0: also show material-point updates per second
-  std::string label = "oobleck";      ///< prefix of every line
-  std::FILE* stream = stderr;         ///< where to write (tests pass a temporary file)
-  std::optional<ProgressMode> mode;   ///< force a mode (tests); otherwise detected
+  bool quiet = false;                ///< --quiet: silent whatever the terminal
+  double line_interval_s = 10.0;     ///< seconds between lines in `lines` mode
+  double points_per_step = 0.0;      ///< > 0: also show material-point updates per second
+  std::string label = "oobleck";     ///< prefix of every line
+  std::FILE* stream = stderr;        ///< where to write (tests pass a temporary file)
+  std::optional<ProgressMode> mode;  ///< force a mode (tests); otherwise detected
 };
 
 /// The mode the environment asks for: silent if quiet or CI is set, bar if `stream` is a

@@ -57,7 +57,8 @@ SeriesWriter SeriesWriter::resume(std::string path, std::vector<std::string> col
   std::string text = ss.str();
   in.close();
   // A run killed while writing a row leaves a last line without its line break: drop it.
-  if (!text.empty() && text.back() != '\n') text.erase(text.rfind('\n') == std::string::npos ? 0 : text.rfind('\n') + 1);
+  if (!text.empty() && text.back() != '\n')
+    text.erase(text.rfind('\n') == std::string::npos ? 0 : text.rfind('\n') + 1);
   std::istringstream lines(text);
   std::string line;
   if (!std::getline(lines, line) || line != header) {
@@ -79,8 +80,8 @@ SeriesWriter SeriesWriter::resume(std::string path, std::vector<std::string> col
       ok = false;
     }
     if (!ok) {
-      throw InputError(fmt::format("series '{}': cannot resume, row {} ('{}') is not {} numbers", path, rows + 2,
-                                   line, columns.size()));
+      throw InputError(fmt::format("series '{}': cannot resume, row {} ('{}') is not {} numbers", path, rows + 2, line,
+                                   columns.size()));
     }
     if (key > keep_until) break;
     kept += line + "\n";

@@ -15,8 +15,7 @@ toml::table parse_toml_file(const std::string& path) {
     return toml::parse_file(path);
   } catch (const toml::parse_error& e) {
     const auto& where = e.source().begin;
-    throw InputError(fmt::format("{}:{}:{}: TOML syntax error: {}", path, where.line, where.column,
-                                 e.description()));
+    throw InputError(fmt::format("{}:{}:{}: TOML syntax error: {}", path, where.line, where.column, e.description()));
   }
 }
 
@@ -68,9 +67,7 @@ std::string TomlReader::misspelled_hint(std::string_view key) const {
   return near.empty() ? std::string() : fmt::format("; found unknown key '{}' — a misspelling?", key_path(near));
 }
 
-double TomlReader::number_or(std::string_view key, double fallback) {
-  return optional_number(key).value_or(fallback);
-}
+double TomlReader::number_or(std::string_view key, double fallback) { return optional_number(key).value_or(fallback); }
 
 std::string TomlReader::string(std::string_view key) {
   const toml::node* node = lookup(key);
@@ -125,8 +122,7 @@ void TomlReader::finish() const {
     if (used_.count(key) != 0) continue;
     const std::string hint = closest_match(key, known);
     throw InputError(fmt::format("{}: key '{}': unknown key{}", file_, key_path(key),
-                                 hint.empty() ? std::string()
-                                              : fmt::format(" (did you mean '{}'?)", key_path(hint))));
+                                 hint.empty() ? std::string() : fmt::format(" (did you mean '{}'?)", key_path(hint))));
   }
 }
 

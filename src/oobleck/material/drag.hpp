@@ -62,8 +62,7 @@ inline double carman_kozeny_F(double phi, double kozeny_constant = 180.0) {
 }
 
 /// Particle Reynolds number Re = |v_s − v_f| n ρ_f d / η_0 [-] (E29).
-inline double drag_reynolds(double rel_speed_m_s, double porosity, double rho_f_kg_m3, double d_m,
-                            double eta_0_Pa_s) {
+inline double drag_reynolds(double rel_speed_m_s, double porosity, double rho_f_kg_m3, double d_m, double eta_0_Pa_s) {
   return rel_speed_m_s * porosity * rho_f_kg_m3 * d_m / eta_0_Pa_s;
 }
 
@@ -102,8 +101,8 @@ void drag_coefficient_per_volume_block(const DragParams& p, const double* phi, c
 /// exactly. Unconditionally stable (Δt C/m ≫ 1 drives Δv_new → 0, never overshoots). Nodes with
 /// one phase missing (m ≤ 0) get no drag. Vec is any type with `a - b` and `scalar * a`.
 template <class Vec>
-inline Vec semi_implicit_drag_force(double m_s_kg, double m_f_kg, const Vec& v_s, const Vec& v_f,
-                                    double C_kg_s, double dt_s) {
+inline Vec semi_implicit_drag_force(double m_s_kg, double m_f_kg, const Vec& v_s, const Vec& v_f, double C_kg_s,
+                                    double dt_s) {
   if (!(m_s_kg > 0.0) || !(m_f_kg > 0.0) || !(C_kg_s > 0.0)) return 0.0 * (v_s - v_f);
   // Written as 1/(1/C + Δt(1/m_s + 1/m_f)) so that C → ∞ (rigid coupling) stays finite.
   const double k = 1.0 / (1.0 / C_kg_s + dt_s * (1.0 / m_s_kg + 1.0 / m_f_kg));

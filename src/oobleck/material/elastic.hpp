@@ -19,8 +19,8 @@ struct LinearElasticParams {
 };
 
 /// One explicit step of the hypo-elastic law from the velocity gradient L [1/s] over dt [s].
-inline Eigen::Matrix3d linear_elastic_update(const Eigen::Matrix3d& sigma, const Eigen::Matrix3d& L,
-                                             double dt_s, const LinearElasticParams& p) {
+inline Eigen::Matrix3d linear_elastic_update(const Eigen::Matrix3d& sigma, const Eigen::Matrix3d& L, double dt_s,
+                                             const LinearElasticParams& p) {
   const Eigen::Matrix3d Dm = 0.5 * (L + L.transpose());
   const Eigen::Matrix3d W = 0.5 * (L - L.transpose());
   Eigen::Matrix3d rate = 2.0 * p.shear_modulus_Pa() * Dm + W * sigma - sigma * W;

@@ -18,15 +18,13 @@ namespace oobleck::material {
 
 /// Parameters of the fluid law, SI units.
 struct FluidParams {
-  double eta_0_Pa_s = 1e-3;       ///< [Pa s] fluid viscosity η_0
-  double kappa_Pa = 1e6;          ///< [Pa] fluid bulk modulus κ (E26; not given by the paper)
-  double rho_f0_kg_m3 = 1000.0;   ///< [kg/m^3] fluid rest density ρ_f0
+  double eta_0_Pa_s = 1e-3;      ///< [Pa s] fluid viscosity η_0
+  double kappa_Pa = 1e6;         ///< [Pa] fluid bulk modulus κ (E26; not given by the paper)
+  double rho_f0_kg_m3 = 1000.0;  ///< [kg/m^3] fluid rest density ρ_f0
 };
 
 /// Effective mixture viscosity seen by the fluid phase, η_0 (1 + 5φ/2) [Pa s] (E25).
-inline double fluid_effective_viscosity(double eta_0_Pa_s, double phi) {
-  return eta_0_Pa_s * (1.0 + 2.5 * phi);
-}
+inline double fluid_effective_viscosity(double eta_0_Pa_s, double phi) { return eta_0_Pa_s * (1.0 + 2.5 * phi); }
 
 /// E25: deviatoric viscous stress τ_f [Pa] from the fluid velocity gradient L = ∇v_f [1/s]
 /// (L_ij = ∂v_i/∂x_j) at granular volume fraction φ.
@@ -71,14 +69,11 @@ inline Eigen::Matrix3d fluid_cauchy_stress_at_pressure(const Eigen::Matrix3d& L,
 }
 
 /// Fluid Cauchy stress σ_f = τ_f − p_f 1 [Pa] (E25 + E26); `J` = ρ_f0/ρ_f.
-inline Eigen::Matrix3d fluid_cauchy_stress(const Eigen::Matrix3d& L, double phi, double J,
-                                           const FluidParams& p) {
+inline Eigen::Matrix3d fluid_cauchy_stress(const Eigen::Matrix3d& L, double phi, double J, const FluidParams& p) {
   return fluid_cauchy_stress_at_pressure(L, phi, fluid_pressure(J, p.kappa_Pa), p.eta_0_Pa_s);
 }
 
 /// Fluid pressure-wave speed √(κ/ρ_f) [m/s] used by the stable time step (model.md §6).
-inline double fluid_wave_speed(double kappa_Pa, double rho_f_kg_m3) {
-  return std::sqrt(kappa_Pa / rho_f_kg_m3);
-}
+inline double fluid_wave_speed(double kappa_Pa, double rho_f_kg_m3) { return std::sqrt(kappa_Pa / rho_f_kg_m3); }
 
 }  // namespace oobleck::material

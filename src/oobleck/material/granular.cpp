@@ -33,10 +33,10 @@ const char* regime_name(GranularRegime r) {
 GranularLaw::GranularLaw(const rheology::Preset& preset, GranularOptions options)
     : steady_(preset.steady), granular_(preset.granular), options_(options) {
   if (granular_.K_4 != 0.0) {
-    throw InputError(fmt::format(
-        "{}: key 'granular.K_4' = {}: the granular return map supports only K_4 = 0 (the value of every "
-        "paper preset; see docs/granular.md)",
-        preset.file.empty() ? preset.name : preset.file, granular_.K_4));
+    throw InputError(
+        fmt::format("{}: key 'granular.K_4' = {}: the granular return map supports only K_4 = 0 (the value of every "
+                    "paper preset; see docs/granular.md)",
+                    preset.file.empty() ? preset.name : preset.file, granular_.K_4));
   }
   if (!(options_.rel_tol > 0.0 && options_.rel_tol < 1e-3) || options_.max_iter < 5) {
     throw InputError(fmt::format("granular law options: rel_tol = {} must lie in (0, 1e-3) and max_iter = {} >= 5",
@@ -93,9 +93,9 @@ struct MapSetup {
   double phi, phi_m, a;    // phi and E1, E2 (f_n when staggered)
   double visc;             // E20 viscous friction times p: visc * gamma_dot/I_m
   double p_tr, tau_tr;
-  double u_eq;             // I_m at which beta = 0
-  double g_max;            // gamma_dot^p at which tau_bar = 0 (radial return)
-  double dil;              // d p/d gamma_dot at p -> 0 (I_m -> infinity: beta -> K_3 phi)
+  double u_eq;   // I_m at which beta = 0
+  double g_max;  // gamma_dot^p at which tau_bar = 0 (radial return)
+  double dil;    // d p/d gamma_dot at p -> 0 (I_m -> infinity: beta -> K_3 phi)
 };
 
 /// The return map's result while it is built (ReturnMap, private to GranularLaw, plus I_m = u).
@@ -186,8 +186,8 @@ OOBLECK_RM_INLINE Inner pressure_balance(const MapSetup& s, double gg, int& iter
 #if defined(__GNUC__)
 [[gnu::noinline]]
 #endif
-double shear_residual_g(const MapSetup& s, double gg, double& dR, bool& all_ok, double& pp, double& uu,
-                               int& iterations) {
+double
+shear_residual_g(const MapSetup& s, double gg, double& dR, bool& all_ok, double& pp, double& uu, int& iterations) {
   const Inner in = pressure_balance(s, gg, iterations);
   all_ok = all_ok && in.ok;
   pp = in.p;
@@ -219,7 +219,10 @@ OOBLECK_RM_INLINE void solve_shear_in_g(const MapSetup& s, double glo, double gh
   bool done = std::fabs(R) <= 1e-14 * tau_tr;
   for (int k = 1; k <= s.cap && !done; ++k) {
     ++iterations;
-    if (R > 0.0) glo = gg; else ghi = gg;
+    if (R > 0.0)
+      glo = gg;
+    else
+      ghi = gg;
     double next = dR < 0.0 ? gg - R / dR : -1.0;
     const bool newton = next > glo && next < ghi;
     if (!newton) next = 0.5 * (glo + ghi);
@@ -281,7 +284,7 @@ OOBLECK_RM_INLINE void shear_yield(const MapSetup& s, double mu0, const F1Value&
 /// E21 and E23 with K_4 = 0, closed form).
 OOBLECK_RM_INLINE void compressive_trial(const MapSetup& s, MapResult& m) {
   const double mu0 = s.law.mu_q(0.0);
-  const bool f3_trial_active = s.phi < s.phi_m;                                          // E23: g(phi) p_tr > 0
+  const bool f3_trial_active = s.phi < s.phi_m;                                        // E23: g(phi) p_tr > 0
   const double f1_trial = s.tau_tr - std::max((mu0 + beta_of(s, 0.0)) * s.p_tr, 0.0);  // E21 at gamma_dot = 0
   if (!f3_trial_active && f1_trial <= 0.0) {
     m.regime = GranularRegime::kElastic;
@@ -388,8 +391,19 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
   const double u_eq = phi < phi_m ? (phi_m - phi) / (a * phi) : 0.0;  // I_m at which beta = 0 (E18)
   const double g_max = tau_tr / Gdt;                                  // gamma_dot^p at which tau_bar = 0
   const double dil = Kdt * K_3_ * phi;  // d p/d gamma_dot at p -> 0 (I_m -> infinity: beta -> K_3 phi)
-  const MapSetup s{*this, F1Consts{Kdt, Gdt, two_eta, d2_rho_s_, K_3_, mu_1_, mu_2_, b_},
-                   options_.rel_tol, options_.max_iter, phi, phi_m, a, visc, p_tr, tau_tr, u_eq, g_max, dil};
+  const MapSetup s{*this,
+                   F1Consts{Kdt, Gdt, two_eta, d2_rho_s_, K_3_, mu_1_, mu_2_, b_},
+                   options_.rel_tol,
+                   options_.max_iter,
+                   phi,
+                   phi_m,
+                   a,
+                   visc,
+                   p_tr,
+                   tau_tr,
+                   u_eq,
+                   g_max,
+                   dil};
   MapResult m;
   if (p_tr > 0.0) {
     compressive_trial(s, m);  // elastic, E21 (f_1), or E21 + E23 (f_1 + f_3)
@@ -409,13 +423,13 @@ GranularLaw::ReturnMap GranularLaw::return_map(double f, double phi, double eta_
   return r;
 }
 
-GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
-                                   double dt, double phi, double eta_0) const {
+GranularUpdate GranularLaw::update(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W, double dt,
+                                   double phi, double eta_0) const {
   return update_impl<true>(state, D, W, dt, phi, eta_0);
 }
 
-GranularStep GranularLaw::advance(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
-                                  double dt, double phi) const {
+GranularStep GranularLaw::advance(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W, double dt,
+                                  double phi) const {
   const GranularUpdate u = update_impl<false>(state, D, W, dt, phi, eta_0_);
   return GranularStep{u.regime, u.ok(), u.gamma_dot_p};
 }
@@ -425,8 +439,9 @@ template <bool kDiagnostics>
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline GranularUpdate GranularLaw::update_impl(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
-                                        double dt, double phi, double eta_0) const {
+inline GranularUpdate
+GranularLaw::update_impl(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W, double dt,
+                         double phi, double eta_0) const {
   GranularUpdate out;
   Trial t;
   if (!begin(state, D, W, dt, phi, eta_0, t, out)) return out;
@@ -437,8 +452,9 @@ inline GranularUpdate GranularLaw::update_impl(GranularState& state, const Eigen
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline bool GranularLaw::begin(const GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W,
-                               double dt, double phi, double eta_0, Trial& t, GranularUpdate& out) const {
+inline bool
+GranularLaw::begin(const GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W, double dt,
+                   double phi, double eta_0, Trial& t, GranularUpdate& out) const {
   // ---- input checks (never throw in the hot loop; report instead) ----
   const T9 S = to9(state.sigma), D9 = to9(D), W9 = to9(W);
   if (!step_inputs_valid(dt, eta_0) || !point_inputs_valid(phi, state.f, S, D9, W9)) {
@@ -496,7 +512,6 @@ void GranularLaw::inv_eta_B_block(const double* phi, double* r) const {
     if (!(phi_j_ - phi[j] > 0.0)) r[j] = 0.0;
 }
 
-
 std::string GranularLaw::describe(const GranularUpdate& u, const GranularState& before, const Eigen::Matrix3d& D,
                                   const Eigen::Matrix3d& W, double dt, double phi) const {
   auto mat = [](const Eigen::Matrix3d& m) {
@@ -508,9 +523,9 @@ std::string GranularLaw::describe(const GranularUpdate& u, const GranularState& 
       "regime {}, iterations {}, relative residual {:.3g}; state before: f = {:.17g}, sigma = {} Pa; "
       "inputs: phi = {:.17g}, dt = {:.17g} s, D = {} 1/s, W = {} 1/s; trial tau_bar = {:.6g} Pa, p = {:.6g} Pa; "
       "result tau_bar = {:.6g} Pa, p = {:.6g} Pa, gamma_dot_p = {:.6g} 1/s",
-      G_, K_, K_0_, granular_.d, granular_.rho_s, u.message ? u.message : "ok", regime_name(u.regime),
-      u.iterations, u.residual, before.f, mat(before.sigma), phi, dt, mat(D), mat(W), u.tau_trial, u.p_trial,
-      u.tau_bar, u.p, u.gamma_dot_p);
+      G_, K_, K_0_, granular_.d, granular_.rho_s, u.message ? u.message : "ok", regime_name(u.regime), u.iterations,
+      u.residual, before.f, mat(before.sigma), phi, dt, mat(D), mat(W), u.tau_trial, u.p_trial, u.tau_bar, u.p,
+      u.gamma_dot_p);
 }
 
 void GranularLaw::require_ok(const GranularUpdate& u, const GranularState& before, const Eigen::Matrix3d& D,

@@ -44,27 +44,27 @@ struct GranularState {
 /// Result and diagnostics of one update (all at the end of the step).
 struct GranularUpdate {
   GranularRegime regime = GranularRegime::kElastic;
-  bool converged = true;   ///< every scalar solve met its tolerance within the iteration cap
-  bool finite = true;      ///< inputs and outputs are finite (false => state left unchanged)
-  bool jammed = false;     ///< phi >= phi_j (see GranularOptions::jammed_structure)
-  int iterations = 0;      ///< scalar-solver iterations of the (final) return map
-  int structure_iterations = 0;  ///< return maps evaluated by the implicit structure update (0: staggered)
-  double tau_bar = 0.0;    ///< equivalent shear stress tau_bar [Pa]
-  double p = 0.0;          ///< granular pressure p~ [Pa]
-  double tau_trial = 0.0;  ///< tau_bar of the elastic trial [Pa]
-  double p_trial = 0.0;    ///< p~ of the elastic trial [Pa]
-  double gamma_dot_p = 0.0;  ///< plastic shear rate (E17) [1/s]
-  double xi_dot_1 = 0.0;     ///< separation rate (E22), >= 0 [1/s]
-  double xi_dot_2 = 0.0;     ///< compaction rate (E23), <= 0 [1/s]
-  double I_v = 0.0;          ///< viscous number (E19) [-]
-  double I = 0.0;            ///< inertial number (E19) [-]
-  double I_m = 0.0;          ///< mixed number (E19) [-]
-  double phi_m = 0.0;        ///< phi_m(f) used in the return map (E1; f_n staggered, f_{n+1} implicit) [-]
-  double phi_eq = 0.0;       ///< critical-state fraction (E18) [-]
-  double beta = 0.0;         ///< dilation (E18) [-]
-  double mu_p = 0.0;         ///< internal friction (E20) [-]
-  double f_old = 0.0;        ///< f at the start of the step [-]
-  double residual = 0.0;     ///< relative residual of the final solve (0 for closed forms) [-]
+  bool converged = true;          ///< every scalar solve met its tolerance within the iteration cap
+  bool finite = true;             ///< inputs and outputs are finite (false => state left unchanged)
+  bool jammed = false;            ///< phi >= phi_j (see GranularOptions::jammed_structure)
+  int iterations = 0;             ///< scalar-solver iterations of the (final) return map
+  int structure_iterations = 0;   ///< return maps evaluated by the implicit structure update (0: staggered)
+  double tau_bar = 0.0;           ///< equivalent shear stress tau_bar [Pa]
+  double p = 0.0;                 ///< granular pressure p~ [Pa]
+  double tau_trial = 0.0;         ///< tau_bar of the elastic trial [Pa]
+  double p_trial = 0.0;           ///< p~ of the elastic trial [Pa]
+  double gamma_dot_p = 0.0;       ///< plastic shear rate (E17) [1/s]
+  double xi_dot_1 = 0.0;          ///< separation rate (E22), >= 0 [1/s]
+  double xi_dot_2 = 0.0;          ///< compaction rate (E23), <= 0 [1/s]
+  double I_v = 0.0;               ///< viscous number (E19) [-]
+  double I = 0.0;                 ///< inertial number (E19) [-]
+  double I_m = 0.0;               ///< mixed number (E19) [-]
+  double phi_m = 0.0;             ///< phi_m(f) used in the return map (E1; f_n staggered, f_{n+1} implicit) [-]
+  double phi_eq = 0.0;            ///< critical-state fraction (E18) [-]
+  double beta = 0.0;              ///< dilation (E18) [-]
+  double mu_p = 0.0;              ///< internal friction (E20) [-]
+  double f_old = 0.0;             ///< f at the start of the step [-]
+  double residual = 0.0;          ///< relative residual of the final solve (0 for closed forms) [-]
   const char* message = nullptr;  ///< why ok() is false (static string), else nullptr
   bool ok() const { return converged && finite; }
 };
@@ -111,8 +111,8 @@ class GranularLaw {
     return update(state, D, W, dt, phi, eta_0_);
   }
   /// Same with a local fluid viscosity eta_0 [Pa s] (e.g. a temperature field).
-  GranularUpdate update(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W, double dt,
-                        double phi, double eta_0) const;
+  GranularUpdate update(GranularState& state, const Eigen::Matrix3d& D, const Eigen::Matrix3d& W, double dt, double phi,
+                        double eta_0) const;
 
   /// Hot-loop form of update() (preset eta_0): the same state update, bit for bit, without the
   /// E18-E20 diagnostics of the end state (I_v, I, I_m, phi_eq, beta, mu_p) that the MPM adapter does

@@ -44,8 +44,10 @@ void run_lanes(int jobs, Load&& load, Step&& step, Settle&& settle) {
     for (int l = 0; l < N; ++l) {
       if (lane_job[l] < 0 || !settle(l, lane_job[l])) continue;
       lane_job[l] = next < jobs ? next++ : -1;
-      if (lane_job[l] >= 0) load(l, lane_job[l]);
-      else --active;
+      if (lane_job[l] >= 0)
+        load(l, lane_job[l]);
+      else
+        --active;
     }
   }
 }
@@ -132,8 +134,8 @@ inline bool block_in_plane(const Eigen::Matrix3d* sigma, const Eigen::Matrix3d* 
   for (int i = 0; i < m; ++i) {
     const double* s = sigma[i].data();
     const double* l = L[i].data();
-    const bool zero = (s[2] == 0.0) & (s[5] == 0.0) & (s[6] == 0.0) & (s[7] == 0.0) & (l[2] == 0.0) &
-                      (l[5] == 0.0) & (l[6] == 0.0) & (l[7] == 0.0);
+    const bool zero = (s[2] == 0.0) & (s[5] == 0.0) & (s[6] == 0.0) & (s[7] == 0.0) & (l[2] == 0.0) & (l[5] == 0.0) &
+                      (l[6] == 0.0) & (l[7] == 0.0);
     if (!zero) return false;
   }
   return true;
@@ -292,8 +294,8 @@ template <bool Plane>
   for (int i = 0; i < m; ++i) {
     const double tau = b.r_tau[i], pp = b.r_p[i], gg = b.r_g[i], tau_tr = b.s_tau_tr[i];
     double stiff;
-    const double f_new = structure_step(K_0, tau_star, xi_dot_eps, dt, b.s_f[i], b.t_fm[i], b.t_inv_eta_B[i], tau, gg,
-                                        stiff);
+    const double f_new =
+        structure_step(K_0, tau_star, xi_dot_eps, dt, b.s_f[i], b.t_fm[i], b.t_inv_eta_B[i], tau, gg, stiff);
     const double scale_pos = tau / tau_tr;
     const double scale = tau_tr > 0.0 ? scale_pos : 0.0;
     double sum = f_new + gg + pp;
@@ -303,8 +305,8 @@ template <bool Plane>
       sum += v;
     }
     b.e_f[i] = f_new;
-    const bool fast = (b.r_ok[i] * lanes_ok != 0.0) & !(stiff > stiff_max) & !(b.s_phi[i] >= phi_forced) &
-                      (sum - sum == 0.0);
+    const bool fast =
+        (b.r_ok[i] * lanes_ok != 0.0) & !(stiff > stiff_max) & !(b.s_phi[i] >= phi_forced) & (sum - sum == 0.0);
     b.e_fast[i] = fast ? 1.0 : 0.0;
   }
 }
@@ -389,8 +391,10 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
     int f1_point[kBlock], tj_point[kBlock];
     // ---- (1) trials ----
     // (the in-plane trials also for blocks whose points all happen to be in plane motion)
-    if (in_plane || block_in_plane(sigma + b0, L + b0, m)) batch_trials<true>(kc, b, m, sigma + b0, L + b0, f + b0, phi + b0);
-    else batch_trials<false>(kc, b, m, sigma + b0, L + b0, f + b0, phi + b0);
+    if (in_plane || block_in_plane(sigma + b0, L + b0, m))
+      batch_trials<true>(kc, b, m, sigma + b0, L + b0, f + b0, phi + b0);
+    else
+      batch_trials<false>(kc, b, m, sigma + b0, L + b0, f + b0, phi + b0);
     // E8 on its own, in blocks with the powers in vector lanes (inside begin() they serialised
     // with the trial); lanes of invalid points (and past m) get a stand-in phi and then 0
     static_assert(kBlock % numerics::kMathBlock == 0);
@@ -398,7 +402,8 @@ void GranularLaw::advance_batch(std::int64_t n, Eigen::Matrix3d* sigma, double* 
       double x[numerics::kMathBlock], r[numerics::kMathBlock];
       for (int j = 0; j < numerics::kMathBlock; ++j) x[j] = i0 + j < m && b.ok[i0 + j] != 0.0 ? phi[b0 + i0 + j] : 0.5;
       inv_eta_B_block(x, r);
-      for (int j = 0; j < numerics::kMathBlock && i0 + j < m; ++j) b.t_inv_eta_B[i0 + j] = b.ok[i0 + j] != 0.0 ? r[j] : 0.0;
+      for (int j = 0; j < numerics::kMathBlock && i0 + j < m; ++j)
+        b.t_inv_eta_B[i0 + j] = b.ok[i0 + j] != 0.0 ? r[j] : 0.0;
     }
     // ---- (2) return_map up to its Newton solves: the branches, the closed forms' results, the
     // solves as lists of points ----

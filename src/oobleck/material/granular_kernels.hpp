@@ -2,10 +2,10 @@
 // The granular law's point kernels (E16–E24): the inline, branch-free functions of one material
 // point that both forms of GranularLaw use, the scalar reference (granular.cpp: update, advance,
 // return_map) and the batched lanes (granular_batch.cpp: advance_batch, which runs them across
-// points in vector lanes), and GranularLaw::finish, the end of a point's step, which both inline. Because both call these same functions, in the same order and
-// compiled with the same flags (CMakeLists.txt: no FMA contraction, no errno, no traps), advance_batch
-// gives the results of advance() bit for bit; the contract is the test GranularBatchContract
-// (tests/material/test_granular_batch_contract.cpp). Algorithm: docs/granular.md.
+// points in vector lanes), and GranularLaw::finish, the end of a point's step, which both inline. Because both call
+// these same functions, in the same order and compiled with the same flags (CMakeLists.txt: no FMA contraction, no
+// errno, no traps), advance_batch gives the results of advance() bit for bit; the contract is the test
+// GranularBatchContract (tests/material/test_granular_batch_contract.cpp). Algorithm: docs/granular.md.
 //
 // Internal to those two files (not part of the law's interface).
 #include <algorithm>
@@ -48,7 +48,8 @@ inline bool step_inputs_valid(double dt, double eta_0) {
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline bool point_inputs_valid(double phi, double f, const T9& S, const T9& D, const T9& W) {
+inline bool
+point_inputs_valid(double phi, double f, const T9& S, const T9& D, const T9& W) {
   return (phi > 0.0) & (phi < 1.0) & (f >= 0.0) & (f <= 1.0) & finite9(S) & finite9(D) & finite9(W);
 }
 
@@ -60,7 +61,8 @@ inline bool point_inputs_valid(double phi, double f, const T9& S, const T9& D, c
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void jaumann_trial(const T9& S, const T9& D, const T9& W, double dt, double G, double K, T9& r) {
+inline void
+jaumann_trial(const T9& S, const T9& D, const T9& W, double dt, double G, double K, T9& r) {
   const double two_G = 2.0 * G;
   auto at = [](const T9& m, int i, int j) { return m.v[i + 3 * j]; };
   for (int j = 0; j < 3; ++j) {
@@ -89,7 +91,8 @@ inline void jaumann_trial(const T9& S, const T9& D, const T9& W, double dt, doub
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void jaumann_trial_plane(const T9& S, const T9& D, const T9& W, double dt, double G, double K, T9& r) {
+inline void
+jaumann_trial_plane(const T9& S, const T9& D, const T9& W, double dt, double G, double K, T9& r) {
   const double two_G = 2.0 * G;
   auto at = [](const T9& m, int i, int j) { return m.v[i + 3 * j]; };
   for (int j = 0; j < 2; ++j) {
@@ -113,14 +116,15 @@ inline void jaumann_trial_plane(const T9& S, const T9& D, const T9& W, double dt
 
 /// The E16 trial of one point: s = the deviator of the trial stress, p_tr = -tr/3 and
 /// tau_tr = sqrt(|dev|^2/2). (Results through references: a returned T9 is copied as an aggregate
-/// in the portable build, which stops the vectorisation.) The sums in the order of Eigen's trace() (d00 + (d11 + d22)) and
-/// squaredNorm() (SSE2 pairs summed as two lanes, then the ninth entry), which GCC's Eigen 3.4 uses
-/// for a Matrix3d with or without AVX (with -ffp-contract=off): bit for bit as before.
+/// in the portable build, which stops the vectorisation.) The sums in the order of Eigen's trace() (d00 + (d11 + d22))
+/// and squaredNorm() (SSE2 pairs summed as two lanes, then the ninth entry), which GCC's Eigen 3.4 uses for a Matrix3d
+/// with or without AVX (with -ffp-contract=off): bit for bit as before.
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void elastic_trial(const T9& S, const T9& D, const T9& W, double dt, double G, double K, T9& s,
-                          double& p_tr, double& tau_tr) {
+inline void
+elastic_trial(const T9& S, const T9& D, const T9& W, double dt, double G, double K, T9& s, double& p_tr,
+              double& tau_tr) {
   jaumann_trial(S, D, W, dt, G, K, s);
   p_tr = -(s.v[0] + (s.v[4] + s.v[8])) / 3.0;
   for (int i = 0; i < 3; ++i) s.v[4 * i] += p_tr;  // dev sigma_tr
@@ -135,8 +139,9 @@ inline void elastic_trial(const T9& S, const T9& D, const T9& W, double dt, doub
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void elastic_trial_plane(const T9& S, const T9& D, const T9& W, double dt, double G, double K, T9& s,
-                                double& p_tr, double& tau_tr) {
+inline void
+elastic_trial_plane(const T9& S, const T9& D, const T9& W, double dt, double G, double K, T9& s, double& p_tr,
+                    double& tau_tr) {
   jaumann_trial_plane(S, D, W, dt, G, K, s);
   p_tr = -(s.v[0] + (s.v[4] + s.v[8])) / 3.0;
   s.v[0] += p_tr;
@@ -180,8 +185,9 @@ inline double f1_dmu_q(const F1Consts& c, double uu) {
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void f1_value(const F1Consts& c, double phi, double phi_m, double a, double visc, double p_tr, double tau_tr,
-                     double uu, F1Value& e) {
+inline void
+f1_value(const F1Consts& c, double phi, double phi_m, double a, double visc, double p_tr, double tau_tr, double uu,
+         F1Value& e) {
   e.be = c.K_3 * (phi - phi_m / (1.0 + a * uu));  // E18 beta
   const double A2 = c.d2_rho_s;
   const double B2 = c.two_eta - c.Kdt * e.be * uu * uu;
@@ -203,8 +209,8 @@ inline void f1_value(const F1Consts& c, double phi, double phi_m, double a, doub
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline double f1_slope(const F1Consts& c, double phi_m, double a, double visc, double p_tr, double uu,
-                       const F1Value& e) {
+inline double
+f1_slope(const F1Consts& c, double phi_m, double a, double visc, double p_tr, double uu, const F1Value& e) {
   const double q = 1.0 + a * uu;
   const double be = e.be, dbe = c.K_3 * phi_m * a / (q * q);
   const double dB2 = -c.Kdt * (dbe * uu * uu + 2.0 * be * uu);
@@ -223,7 +229,10 @@ inline double f1_slope(const F1Consts& c, double phi_m, double a, double visc, d
 /// new point, evaluate once more and stop.
 inline int f1_step(double R, double dR, double tau_tr, double tol, double& x, double& lo, double& hi) {
   if (std::fabs(R) <= 1e-14 * tau_tr) return 1;
-  if (R > 0.0) lo = x; else hi = x;
+  if (R > 0.0)
+    lo = x;
+  else
+    hi = x;
   double next = (dR < 0.0) ? x - R / dR : -1.0;
   const bool newton = next > lo && next < hi;
   if (!newton) next = (lo > 0.0 && hi > 4.0 * lo) ? std::sqrt(lo * hi) : 0.5 * (lo + hi);
@@ -238,8 +247,9 @@ inline int f1_step(double R, double dR, double tau_tr, double tol, double& x, do
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void compressive(const F1Consts& c, double phi, double phi_m, double a, double visc, double p_tr,
-                        double tau_tr, double u_eq, F1Value& e_lo, double& g, double& p, double& tau, double& xi2) {
+inline void
+compressive(const F1Consts& c, double phi, double phi_m, double a, double visc, double p_tr, double tau_tr, double u_eq,
+            F1Value& e_lo, double& g, double& p, double& tau, double& xi2) {
   f1_value(c, phi, phi_m, a, visc, p_tr, tau_tr, u_eq, e_lo);
   const double mq = f1_mu_q(c, u_eq);
   const double u2 = u_eq * u_eq;
@@ -263,8 +273,9 @@ inline void compressive(const F1Consts& c, double phi, double phi_m, double a, d
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void f1_start(const F1Consts& c, double mu0, double phi, double phi_m, double a, double visc, double p_tr,
-                     double tau_tr, double u_eq, double g_max, const F1Value& e_lo, double& x, double& hi) {
+inline void
+f1_start(const F1Consts& c, double mu0, double phi, double phi_m, double a, double visc, double p_tr, double tau_tr,
+         double u_eq, double g_max, const F1Value& e_lo, double& x, double& hi) {
   const double e_lo_dR = f1_slope(c, phi_m, a, visc, p_tr, u_eq, e_lo);
   const double lo = u_eq;
   const double Q_max = g_max * (g_max * c.d2_rho_s + c.two_eta);  // E19 Q(gamma_max)
@@ -292,7 +303,8 @@ inline void f1_start(const F1Consts& c, double mu0, double phi, double phi_m, do
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline double tension_start(const F1Consts& c, double phi_m, double a, double p_tr, double dil, double g_max) {
+inline double
+tension_start(const F1Consts& c, double phi_m, double a, double p_tr, double dil, double g_max) {
   const double S = p_tr + dil * g_max, ck = c.Kdt * g_max;
   const double u_q = std::sqrt((g_max * (g_max * c.d2_rho_s + c.two_eta)) / S);
   const double u_0 = (phi_m * ck * c.K_3 / S - 1.0) / a;
@@ -312,8 +324,9 @@ inline double separated_xi1(const F1Consts& c, double phi, double p_tr, double g
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline double structure_step(double K_0, double tau_star, double xi_dot_eps, double dt, double fn, double fm,
-                             double inv_eta_B, double tau, double g, double& stiff) {
+inline double
+structure_step(double K_0, double tau_star, double xi_dot_eps, double dt, double fn, double fm, double inv_eta_B,
+               double tau, double g, double& stiff) {
   const double x = tau / tau_star;
   const double Hp = K_0 * g * x * std::sqrt(x);
   const double Sp = K_0 * (g + tau * inv_eta_B + xi_dot_eps);
@@ -339,9 +352,9 @@ inline double friction_of(const F1Consts& c, double phi, double phi_m, double a,
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline double tension_step(const F1Consts& c, double phi, double phi_m, double a, double visc, double p_tr,
-                        double tau_tr, double g_max, double tol, double& gg, double& uu, double& pp_out,
-                        double& Rr_out) {
+inline double
+tension_step(const F1Consts& c, double phi, double phi_m, double a, double visc, double p_tr, double tau_tr,
+             double g_max, double tol, double& gg, double& uu, double& pp_out, double& Rr_out) {
   const double iu = 1.0 / uu;
   const double Qp = 2.0 * gg * c.d2_rho_s + c.two_eta;
   const double pp = (gg * (gg * c.d2_rho_s + c.two_eta)) * iu * iu;
@@ -361,8 +374,7 @@ inline double tension_step(const F1Consts& c, double phi, double phi_m, double a
   const double dg = (hu * Rr - h * Ru) / det;
   const double du = (h * Rg - hg * Rr) / det;
   const double g1 = gg + dg, u1 = uu + du;
-  const bool in_range =
-      (g1 > 0.0) & (g1 <= g_max) & (u1 > 0.0) & (std::fabs(u1) <= std::numeric_limits<double>::max());
+  const bool in_range = (g1 > 0.0) & (g1 <= g_max) & (u1 > 0.0) & (std::fabs(u1) <= std::numeric_limits<double>::max());
   const bool small = (std::fabs(dg) <= tol * g1) & (std::fabs(du) <= tol * u1);
   pp_out = pp;
   Rr_out = Rr;
@@ -404,8 +416,9 @@ template <class Map, class FNext, class ReturnMap>
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline bool structure_implicit(const Map& map, const FNext& f_next, double fn, double fm, int max_iter, ReturnMap& r,
-                               double& f_used, double& f_new, int& structure_iterations) {
+inline bool
+structure_implicit(const Map& map, const FNext& f_next, double fn, double fm, int max_iter, ReturnMap& r,
+                   double& f_used, double& f_new, int& structure_iterations) {
   ReturnMap rz;
   double dummy = 0.0;
   auto Z = [&](double ff, ReturnMap& rr, double& fnext) {
@@ -472,8 +485,9 @@ template <bool kDiagnostics>
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void end_state_diagnostics(const GranularLaw& law, double phi, double eta_0, double phi_m, double a, double p,
-                                  double g, GranularRegime regime, GranularUpdate& out) {
+inline void
+end_state_diagnostics(const GranularLaw& law, double phi, double eta_0, double phi_m, double a, double p, double g,
+                      GranularRegime regime, GranularUpdate& out) {
   const rheology::GranularParams& gp = law.granular();
   if constexpr (!kDiagnostics) {
     (void)gp;
@@ -486,10 +500,10 @@ inline void end_state_diagnostics(const GranularLaw& law, double phi, double eta
     (void)regime;
     (void)out;
   } else if (p > 0.0 && g > 0.0) {
-    out.I_v = eta_0 * g / p;                      // E19
+    out.I_v = eta_0 * g / p;  // E19
     out.I = g * gp.d * std::sqrt(gp.rho_s / p);
     out.I_m = std::sqrt(out.I * out.I + 2.0 * out.I_v);
-    out.phi_eq = phi_m / (1.0 + a * out.I_m);     // E18
+    out.phi_eq = phi_m / (1.0 + a * out.I_m);  // E18
     out.beta = gp.K_3 * (phi - out.phi_eq);
     out.mu_p = law.mu_q(out.I_m) + 2.5 * phi * out.I_v / (a * out.I_m);  // E20
   } else if (p > 0.0 || regime == GranularRegime::kElastic) {
@@ -509,8 +523,9 @@ inline void end_state_diagnostics(const GranularLaw& law, double phi, double eta
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void radial_return(const Eigen::Matrix3d& s_tr, double tau_tr, double tau, double p, double g, double f_new,
-                          GranularState& state, GranularUpdate& out) {
+inline void
+radial_return(const Eigen::Matrix3d& s_tr, double tau_tr, double tau, double p, double g, double f_new,
+              GranularState& state, GranularUpdate& out) {
   // (element by element: the Eigen expression did not inline; same operations)
   const double scale = tau_tr > 0.0 ? tau / tau_tr : 0.0;
   Eigen::Matrix3d sig;
@@ -539,8 +554,9 @@ template <bool kDiagnostics>
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void GranularLaw::finish(GranularState& state, const Trial& t, ReturnMap r, double dt, double phi,
-                                double eta_0, GranularUpdate& out) const {
+inline void
+GranularLaw::finish(GranularState& state, const Trial& t, ReturnMap r, double dt, double phi, double eta_0,
+                    GranularUpdate& out) const {
   out.f_old = state.f;
   const double fn = state.f;
   out.jammed = phi >= phi_j_;
@@ -548,7 +564,8 @@ inline void GranularLaw::finish(GranularState& state, const Trial& t, ReturnMap 
   out.tau_trial = tau_tr;
   out.p_trial = p_tr;
   // Linearly implicit E24 step with end-of-step tau_bar, gamma_dot^p: f = (f_n + dt H' f_m)/(1 + dt (H' + S')),
-  // H' = K_0 gamma_dot^p (tau_bar/tau*)^{3/2}, S' = K_0 (gamma_dot^p + tau_bar/eta_B + xi_dot_eps); `stiff` = dt (H' + S').
+  // H' = K_0 gamma_dot^p (tau_bar/tau*)^{3/2}, S' = K_0 (gamma_dot^p + tau_bar/eta_B + xi_dot_eps); `stiff` = dt (H' +
+  // S').
   auto f_next = [&](const ReturnMap& rr, double& stiff) {
     return granular_kernels::structure_step(K_0_, tau_star_, xi_dot_eps_, dt, fn, fm, inv_eta_B, rr.tau, rr.g, stiff);
   };

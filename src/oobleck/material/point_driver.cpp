@@ -117,7 +117,10 @@ double stress_controlled_step(const GranularLaw& law, GranularState& state, doub
 ShearResult run_shear(const GranularLaw& law, const ShearOptions& o, const Progress& progress) {
   ShearResult r;
   const double rate_scale =
-      o.stress_controlled ? o.shear_stress / (law.eta_0() * rheology::eta_r_low(law.steady(), std::min(o.phi, 0.999 * law.steady().phi_j))) : o.shear_rate;
+      o.stress_controlled
+          ? o.shear_stress /
+                (law.eta_0() * rheology::eta_r_low(law.steady(), std::min(o.phi, 0.999 * law.steady().phi_j)))
+          : o.shear_rate;
   r.dt = o.dt > 0.0 ? o.dt : default_dt(law, o.phi, rate_scale, o.duration);
   const long n = std::max(1L, static_cast<long>(std::ceil(o.duration / r.dt - 1e-9)));
   r.steps = n;
@@ -151,9 +154,11 @@ ShearResult run_shear(const GranularLaw& law, const ShearOptions& o, const Progr
     // sample k when it crosses the next of `samples` evenly spaced times
     if (k == n || static_cast<double>(k) >= static_cast<double>(next_sample) * static_cast<double>(n) / samples) {
       r.samples.push_back(make_sample(law, t, strain, rate, o.phi, st, u));
-      while (static_cast<double>(next_sample) * static_cast<double>(n) / samples <= static_cast<double>(k)) ++next_sample;
+      while (static_cast<double>(next_sample) * static_cast<double>(n) / samples <= static_cast<double>(k))
+        ++next_sample;
     }
-    if (progress && k % progress_every == 0) progress(static_cast<double>(k) / static_cast<double>(n), r.samples.back());
+    if (progress && k % progress_every == 0)
+      progress(static_cast<double>(k) / static_cast<double>(n), r.samples.back());
   }
   r.state = st;
   return r;
@@ -174,7 +179,8 @@ struct ReducedRhs {
     const double x = tau / s.tau_star;
     const double K0 = law.granular().K_0;
     df = K0 * gdp * x * std::sqrt(x) * (fm - f) - K0 * (gdp + tau * inv_eta_B + s.xi_dot_eps) * f;  // E24
-    rate_scale = (gap > 0.0 ? law.G() / (c * law.eta_0()) : 0.0) + K0 * (gdp * (1.0 + x * std::sqrt(x)) + tau * inv_eta_B + s.xi_dot_eps);
+    rate_scale = (gap > 0.0 ? law.G() / (c * law.eta_0()) : 0.0) +
+                 K0 * (gdp * (1.0 + x * std::sqrt(x)) + tau * inv_eta_B + s.xi_dot_eps);
   }
 };
 
@@ -211,8 +217,8 @@ void reduced_relax_ode(const GranularLaw& law, double phi, double span, double& 
     if (!std::isfinite(tau) || !std::isfinite(f)) break;
   }
   if (!std::isfinite(tau) || !std::isfinite(f)) {
-    throw NumericalError(fmt::format("reduced relaxation ODE: non-finite state (tau_bar = {}, f = {}) at phi = {}",
-                                     tau, f, phi));
+    throw NumericalError(
+        fmt::format("reduced relaxation ODE: non-finite state (tau_bar = {}, f = {}) at phi = {}", tau, f, phi));
   }
 }
 
@@ -222,8 +228,8 @@ double steady_rate_at_stress(const rheology::SteadyParams& s, double phi, double
   auto at = [&](double f) { return rheology::steady_point(s, phi, f, fu - f); };
   const double tau_lo = at(1e-12 * fu).shear_stress;
   if (!(stress > tau_lo)) {
-    throw InputError(fmt::format("shear stress {} Pa is below the smallest steady stress {} Pa at phi = {}", stress,
-                                 tau_lo, phi));
+    throw InputError(
+        fmt::format("shear stress {} Pa is below the smallest steady stress {} Pa at phi = {}", stress, tau_lo, phi));
   }
   double lo = 1e-12 * fu, hi = fu * (1.0 - 1e-12);
   if (at(hi).shear_stress < stress) return at(hi).shear_rate;
@@ -242,7 +248,8 @@ RelaxResult run_relax(const GranularLaw& law, const RelaxOptions& o, const Progr
   GranularState st;
   Eigen::Matrix3d D, W;
   simple_shear_rates(o.shear_rate, D, W);
-  const double rate_est = o.stress_controlled ? steady_rate_at_stress(law.steady(), o.phi, o.shear_stress) : o.shear_rate;
+  const double rate_est =
+      o.stress_controlled ? steady_rate_at_stress(law.steady(), o.phi, o.shear_stress) : o.shear_rate;
   // steps of at most 2% strain that also resolve the structure rate K_0 gamma_dot (1 + H) of E24
   auto pre_dt = [&](double tau_est) {
     const double x = tau_est / law.steady().tau_star;
@@ -279,14 +286,17 @@ RelaxResult run_relax(const GranularLaw& law, const RelaxOptions& o, const Progr
     }
   }
   if (!steady) {
-    throw NumericalError(fmt::format("point relax: pre-shear (rate {} 1/s) did not reach a steady state within {} "
-                                     "strain (tau_bar = {} Pa, f = {}); at tau_bar comparable to G = {} Pa the "
-                                     "hypo-elastic rotation relaxes slowly",
-                                     rate_est, rate_est * dt_pre * static_cast<double>(k), u.tau_bar, st.f, law.G()));
+    throw NumericalError(
+        fmt::format("point relax: pre-shear (rate {} 1/s) did not reach a steady state within {} "
+                    "strain (tau_bar = {} Pa, f = {}); at tau_bar comparable to G = {} Pa the "
+                    "hypo-elastic rotation relaxes slowly",
+                    rate_est, rate_est * dt_pre * static_cast<double>(k), u.tau_bar, st.f, law.G()));
   }
   if (u.tau_bar <= 0.0 || u.regime == GranularRegime::kSeparated) {
-    throw NumericalError(fmt::format("point relax: the pre-sheared state carries no granular stress (regime {}, "
-                                     "tau_bar = {} Pa) at phi = {}", regime_name(u.regime), u.tau_bar, o.phi));
+    throw NumericalError(
+        fmt::format("point relax: the pre-sheared state carries no granular stress (regime {}, "
+                    "tau_bar = {} Pa) at phi = {}",
+                    regime_name(u.regime), u.tau_bar, o.phi));
   }
   r.preshear_strain = rate_est * dt_pre * static_cast<double>(k + 1);
   r.tau_bar_0 = u.tau_bar;
@@ -298,9 +308,10 @@ RelaxResult run_relax(const GranularLaw& law, const RelaxOptions& o, const Progr
     const double c = rheology::granular_viscosity(o.phi, rheology::a_of_f(s, st.f), gap, s.mu_c);
     r.relaxation_time_0 = c * law.eta_0() / law.G();
     if (!(gap > 0.0) || !std::isfinite(r.relaxation_time_0)) {
-      throw NumericalError(fmt::format("point relax: the pre-sheared state is shear-jammed (f = {} reached f_jam, "
-                                       "phi_m(f) = phi): no viscous relaxation; lower the pre-shear stress",
-                                       st.f));
+      throw NumericalError(
+          fmt::format("point relax: the pre-sheared state is shear-jammed (f = {} reached f_jam, "
+                      "phi_m(f) = phi): no viscous relaxation; lower the pre-shear stress",
+                      st.f));
     }
   }
   // ---- relaxation: D = W = 0 ----

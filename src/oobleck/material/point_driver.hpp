@@ -28,14 +28,14 @@ struct PointSample {
 
 /// Simple shear v_x = gamma_dot y at fixed volume (tr D = 0).
 struct ShearOptions {
-  double phi = 0.0;               ///< volume fraction [-]
+  double phi = 0.0;                ///< volume fraction [-]
   bool stress_controlled = false;  ///< false: shear_rate imposed; true: shear_stress imposed
-  double shear_rate = 0.0;        ///< [1/s] (rate control)
-  double shear_stress = 0.0;      ///< mixture tau [Pa] (stress control)
-  double duration = 0.0;          ///< [s]
-  double dt = 0.0;                ///< [s]; <= 0 picks default_dt()
-  double f0 = 0.0;                ///< initial structure [-]
-  int samples = 1000;             ///< recorded rows (evenly spaced in time, plus the first and last)
+  double shear_rate = 0.0;         ///< [1/s] (rate control)
+  double shear_stress = 0.0;       ///< mixture tau [Pa] (stress control)
+  double duration = 0.0;           ///< [s]
+  double dt = 0.0;                 ///< [s]; <= 0 picks default_dt()
+  double f0 = 0.0;                 ///< initial structure [-]
+  int samples = 1000;              ///< recorded rows (evenly spaced in time, plus the first and last)
 };
 
 struct ShearResult {
@@ -67,14 +67,14 @@ double stress_controlled_step(const GranularLaw& law, GranularState& state, doub
 
 /// Relaxation after cessation of steady shear.
 struct RelaxOptions {
-  double phi = 0.0;         ///< [-]
-  double shear_rate = 0.0;  ///< pre-shear rate [1/s] (rate-controlled pre-shear)
+  double phi = 0.0;                ///< [-]
+  double shear_rate = 0.0;         ///< pre-shear rate [1/s] (rate-controlled pre-shear)
   bool stress_controlled = false;  ///< pre-shear at imposed mixture shear stress instead
   double shear_stress = 0.0;       ///< pre-shear mixture shear stress [Pa] (stress control)
-  double duration = 0.0;    ///< relaxation time span after cessation [s]
-  double dt = 0.0;          ///< first relaxation step [s]; <= 0: 1/20 of the initial relaxation time
-  double growth = 0.02;     ///< dt = max(dt0, growth * t) after cessation (log-time resolution)
-  int samples = 200;        ///< recorded rows (log-spaced in time)
+  double duration = 0.0;           ///< relaxation time span after cessation [s]
+  double dt = 0.0;                 ///< first relaxation step [s]; <= 0: 1/20 of the initial relaxation time
+  double growth = 0.02;            ///< dt = max(dt0, growth * t) after cessation (log-time resolution)
+  int samples = 200;               ///< recorded rows (log-spaced in time)
 };
 
 struct RelaxSample {

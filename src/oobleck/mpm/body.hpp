@@ -77,18 +77,19 @@ struct Body {
   static constexpr int NC = G::ncomp;
 
   std::string name;
-  std::vector<double> mass_kg;      ///< point mass (per radian in axisymmetric mode)
-  std::vector<double> volume_m3;    ///< current point volume V_p
-  std::vector<double> volume0_m3;   ///< initial point volume
-  std::vector<Vec<D>> x_m;          ///< position
-  std::vector<Vec<NC>> v_m_s;       ///< velocity
-  std::vector<Mat<NC, D>> C_1_s;    ///< APIC affine velocity matrix (ncomp × dim)
-  std::vector<Mat3> L_1_s;          ///< 3×3 velocity gradient of the last step, geometry terms incl. (axisymmetric: relative to the turning local basis, geometry.hpp)
-  std::vector<Mat3> stress_Pa;      ///< Cauchy stress, positive in tension
-  std::vector<Vec<NC>> f_ext_N;     ///< external force on the point (surface loads), spread by N_ip
+  std::vector<double> mass_kg;     ///< point mass (per radian in axisymmetric mode)
+  std::vector<double> volume_m3;   ///< current point volume V_p
+  std::vector<double> volume0_m3;  ///< initial point volume
+  std::vector<Vec<D>> x_m;         ///< position
+  std::vector<Vec<NC>> v_m_s;      ///< velocity
+  std::vector<Mat<NC, D>> C_1_s;   ///< APIC affine velocity matrix (ncomp × dim)
+  std::vector<Mat3> L_1_s;  ///< 3×3 velocity gradient of the last step, geometry terms incl. (axisymmetric: relative to
+                            ///< the turning local basis, geometry.hpp)
+  std::vector<Mat3> stress_Pa;   ///< Cauchy stress, positive in tension
+  std::vector<Vec<NC>> f_ext_N;  ///< external force on the point (surface loads), spread by N_ip
   // Mixture fields interpolated from the nodes in G2P (fluid phase of a mixture only):
-  std::vector<double> phi;          ///< granular volume fraction 1 − n at the point
-  std::vector<double> div_q_1_s;    ///< div of the mixture volume flux q (E27)
+  std::vector<double> phi;        ///< granular volume fraction 1 − n at the point
+  std::vector<double> div_q_1_s;  ///< div of the mixture volume flux q (E27)
   std::unique_ptr<StressLaw<G>> law;
 
   std::int64_t size() const { return static_cast<std::int64_t>(mass_kg.size()); }
@@ -159,8 +160,8 @@ struct Body {
 /// (cell size h), all of density ρ, velocity from v(x). Point volume from the geometry's measure
 /// (per radian, A r, in axisymmetric mode).
 template <class G, class VFun>
-void fill_box(Body<G>& body, const Vec<G::dim>& lo, const Vec<G::dim>& hi, double h_m, int ppc,
-              double density_kg_m3, VFun&& velocity) {
+void fill_box(Body<G>& body, const Vec<G::dim>& lo, const Vec<G::dim>& hi, double h_m, int ppc, double density_kg_m3,
+              VFun&& velocity) {
   constexpr int D = G::dim;
   const double dx = h_m / ppc;
   int n[D];

@@ -154,8 +154,8 @@ void fold_wall_images(const Grid<G::dim>& grid, const BoundaryConditions<G::dim>
 /// pore-pressure split is not included, so friction follows the effective normal stress), limits
 /// the tangential slip: |v_t − U_t| ← max(0, |v_t − U_t| − μ J_n/m_real) when J_n > 0.
 template <class G>
-void apply_boundary_conditions(const Grid<G::dim>& grid, const BoundaryConditions<G::dim>& bc,
-                               GridField<G>& field, double dt_s = 0.0) {
+void apply_boundary_conditions(const Grid<G::dim>& grid, const BoundaryConditions<G::dim>& bc, GridField<G>& field,
+                               double dt_s = 0.0) {
   constexpr int D = G::dim, NC = G::ncomp;
   for (int a = 0; a < D; ++a) {
     if (grid.periodic[a]) continue;

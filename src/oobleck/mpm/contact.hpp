@@ -69,10 +69,10 @@ template <class G>
 struct RigidMotion {
   static constexpr int NC = G::ncomp;
   BodyMotion kind = BodyMotion::Deformable;
-  Vec<NC> velocity_m_s = Vec<NC>::Zero();  ///< v_0 (Prescribed) or the current V (FreeRigid)
-  Vec<NC> free_mask = Vec<NC>::Ones();     ///< FreeRigid: 1 = component free, 0 = held fixed
-  double mass_kg = 0.0;                    ///< Σ m_p (per radian in axisymmetric mode)
-  Vec<NC> predicted_m_s = Vec<NC>::Zero(); ///< V + Δt g of the current step (internal)
+  Vec<NC> velocity_m_s = Vec<NC>::Zero();   ///< v_0 (Prescribed) or the current V (FreeRigid)
+  Vec<NC> free_mask = Vec<NC>::Ones();      ///< FreeRigid: 1 = component free, 0 = held fixed
+  double mass_kg = 0.0;                     ///< Σ m_p (per radian in axisymmetric mode)
+  Vec<NC> predicted_m_s = Vec<NC>::Zero();  ///< V + Δt g of the current step (internal)
   bool rigid() const { return kind != BodyMotion::Deformable; }
   /// Persistent state (mpm/fields.hpp): the velocity (a FreeRigid body's is integrated).
   void declare_fields(FieldList& list) { list.add_values("rigid_velocity", {velocity_m_s.data(), NC}, "m/s"); }
@@ -82,9 +82,9 @@ struct RigidMotion {
 template <class G>
 struct ContactPair {
   static constexpr int NC = G::ncomp;
-  int solid = -1;                          ///< body index of the solid
-  double friction_coefficient = 0.0;       ///< Coulomb μ between solid and grains [-]
-  Vec<NC> force_N = Vec<NC>::Zero();       ///< contact force on the solid, last step [N]
+  int solid = -1;                               ///< body index of the solid
+  double friction_coefficient = 0.0;            ///< Coulomb μ between solid and grains [-]
+  Vec<NC> force_N = Vec<NC>::Zero();            ///< contact force on the solid, last step [N]
   Vec<NC> force_on_grains_N = Vec<NC>::Zero();  ///< part of −force_N acting on the grains [N]
   Vec<NC> impulse_sum_N_s = Vec<NC>::Zero();    ///< Σ over all steps of the impulse on the solid
   /// Contact detection (see header): a node is a contact candidate where both have mass and the
@@ -114,11 +114,11 @@ struct ContactPair {
 template <class G>
 struct Motor {
   int body = -1;
-  double omega_rad_s = 0.0;     ///< target mean angular velocity ω* (counter-clockwise positive)
-  double gain = 1.0;            ///< fraction of the error removed per step, (0, 1]
-  double omega_measured_rad_s = 0.0;  ///< ω̄ before the last correction
-  double torque_N_m = 0.0;      ///< motor torque of the last step, I Δω/Δt
-  double inertia_kg_m2 = 0.0;   ///< I = Σ m |x − x_c|² at the last step
+  double omega_rad_s = 0.0;                    ///< target mean angular velocity ω* (counter-clockwise positive)
+  double gain = 1.0;                           ///< fraction of the error removed per step, (0, 1]
+  double omega_measured_rad_s = 0.0;           ///< ω̄ before the last correction
+  double torque_N_m = 0.0;                     ///< motor torque of the last step, I Δω/Δt
+  double inertia_kg_m2 = 0.0;                  ///< I = Σ m |x − x_c|² at the last step
   Vec<G::dim> centre_m = Vec<G::dim>::Zero();  ///< centre of mass at the last step
 };
 
@@ -143,8 +143,8 @@ Vec<D> periodic_difference(const Grid<D>& grid, const Vec<D>& x, const Vec<D>& x
 /// Mean angular velocity, centre and inertia of a plane body (see Motor), positions unwrapped
 /// about the first point on periodic axes.
 template <class G>
-void angular_state(const Body<G>& body, const Grid<G::dim>& grid, double& omega, double& inertia,
-                   Vec<G::dim>& centre, Vec<G::ncomp>& velocity) {
+void angular_state(const Body<G>& body, const Grid<G::dim>& grid, double& omega, double& inertia, Vec<G::dim>& centre,
+                   Vec<G::ncomp>& velocity) {
   static_assert(G::dim == 2 && G::ncomp == 2, "angular_state: plane strain only");
   const std::int64_t np = body.size();
   omega = inertia = 0.0;
@@ -199,8 +199,8 @@ void apply_motor(Motor<G>& motor, Body<G>& body, const Grid<G::dim>& grid, doubl
 /// Total mass and predicted velocity of a rigid body; its nodal velocity (and v_old) set to the
 /// rigid velocity on every node with mass (model.md §8).
 template <class G>
-void predict_rigid(RigidMotion<G>& rm, const Body<G>& body, GridField<G>& field,
-                   const Vec<G::ncomp>& gravity, double dt_s) {
+void predict_rigid(RigidMotion<G>& rm, const Body<G>& body, GridField<G>& field, const Vec<G::ncomp>& gravity,
+                   double dt_s) {
   double M = 0.0;
   for (double m : body.mass_kg) M += m;
   rm.mass_kg = M;
@@ -263,12 +263,12 @@ void scatter_mass_gradient_near(const Body<G>& body, const ShapeCache<G::dim>& c
 /// = 0 for a phase absent at the node. Returns the impulses on the grains (J_s) and the fluid
 /// (J_f); the solid receives −(J_s + J_f). Velocities are not modified.
 template <int NC>
-inline bool contact_impulses(const Vec<NC>& n, double mb, const Vec<NC>& vb, double ms, const Vec<NC>& vs,
-                             double mf, const Vec<NC>& vf, double mu, Vec<NC>& Js, Vec<NC>& Jf) {
+inline bool contact_impulses(const Vec<NC>& n, double mb, const Vec<NC>& vb, double ms, const Vec<NC>& vs, double mf,
+                             const Vec<NC>& vf, double mu, Vec<NC>& Js, Vec<NC>& Jf) {
   Js.setZero();
   Jf.setZero();
   const double vbn = vb.dot(n), vsn = vs.dot(n), vfn = vf.dot(n);
-  bool app_s = ms > 0.0 && vsn < vbn, app_f = mf > 0.0 && vfn < vbn;
+  bool app_s = ms > 0.0 && vsn<vbn, app_f = mf> 0.0 && vfn < vbn;
   if (!app_s && !app_f) return false;
   const bool infinite = std::isinf(mb);
   double vn = vbn;
@@ -348,10 +348,10 @@ double node_measure(const Grid<G::dim>& grid, int i) {
 /// with the node weights into pair.force_N. Serial over nodes (deterministic sums; the solid
 /// occupies few nodes). Returns the total impulse on the solid.
 template <class G>
-Vec<G::ncomp> resolve_contact(ContactPair<G>& pair, const RigidMotion<G>& rm, GridField<G>& solid,
-                              GridField<G>* grains, GridField<G>* fluid, const std::vector<double>& weight,
-                              const double* mixture_volume, const std::vector<double>& node_volume,
-                              const Vec<G::dim>* mixture_gradient, double dt_s) {
+Vec<G::ncomp> resolve_contact(ContactPair<G>& pair, const RigidMotion<G>& rm, GridField<G>& solid, GridField<G>* grains,
+                              GridField<G>* fluid, const std::vector<double>& weight, const double* mixture_volume,
+                              const std::vector<double>& node_volume, const Vec<G::dim>* mixture_gradient,
+                              double dt_s) {
   constexpr int NC = G::ncomp, D = G::dim;
   Vec<NC> J_body = Vec<NC>::Zero(), J_grains = Vec<NC>::Zero();
   int active = 0;
@@ -364,8 +364,7 @@ Vec<G::ncomp> resolve_contact(ContactPair<G>& pair, const RigidMotion<G>& rm, Gr
     if (!(mb > 0.0) || weight[i] == 0.0) continue;
     const double ms = grains ? grains->mass_kg[i] : 0.0, mf = fluid ? fluid->mass_kg[i] : 0.0;
     if (!(ms > 0.0) && !(mf > 0.0)) continue;
-    if (pair.overlap_threshold > 0.0 &&
-        pair.volume_m3[i] + mixture_volume[i] < pair.overlap_threshold * node_volume[i])
+    if (pair.overlap_threshold > 0.0 && pair.volume_m3[i] + mixture_volume[i] < pair.overlap_threshold * node_volume[i])
       continue;  // both have mass, but their smoothed volumes leave a gap: not touching
     Vec<D> g = pair.mass_gradient[i];
     if (mixture_gradient) g -= mixture_gradient[i];
@@ -375,8 +374,8 @@ Vec<G::ncomp> resolve_contact(ContactPair<G>& pair, const RigidMotion<G>& rm, Gr
     n.template head<D>() = g / gn;  // Σ m_p ∇N_i(x_p) points away from the body at its boundary
     Vec<NC> Js, Jf;
     if (!contact_impulses<NC>(n, prescribed ? INFINITY : mb, solid.velocity[i], ms,
-                              ms > 0.0 ? grains->velocity[i] : zero, mf,
-                              mf > 0.0 ? fluid->velocity[i] : zero, mu, Js, Jf))
+                              ms > 0.0 ? grains->velocity[i] : zero, mf, mf > 0.0 ? fluid->velocity[i] : zero, mu, Js,
+                              Jf))
       continue;
     ++active;
     if (ms > 0.0) grains->velocity[i] += Js / ms;
@@ -417,8 +416,7 @@ Vec<G::ncomp> resolve_rigid_contact(ContactPair<G>& pair, RigidMotion<G>& rm, co
     if (!(mb > 0.0) || weight[i] == 0.0) return false;
     const double ms = grains ? grains->mass_kg[i] : 0.0, mf = fluid ? fluid->mass_kg[i] : 0.0;
     if (!(ms > 0.0) && !(mf > 0.0)) return false;
-    if (pair.overlap_threshold > 0.0 &&
-        pair.volume_m3[i] + mixture_volume[i] < pair.overlap_threshold * node_volume[i])
+    if (pair.overlap_threshold > 0.0 && pair.volume_m3[i] + mixture_volume[i] < pair.overlap_threshold * node_volume[i])
       return false;
     Vec<D> g = pair.mass_gradient[i];
     if (mixture_gradient) g -= mixture_gradient[i];

@@ -41,7 +41,7 @@ struct PersistentField {
   std::variant<std::monostate, std::span<double>, std::span<std::uint8_t>> data;
   bool in_checkpoint = true;
   FrameForm frame = FrameForm::none;
-  std::string frame_name;  ///< the frame's name when it differs from `name`
+  std::string frame_name;    ///< the frame's name when it differs from `name`
   int frame_rank = 1 << 20;  ///< frames show fields by rank, then in declaration order
   /// Frame-only field: fill one value per item (called when a frame is written).
   std::function<void(std::span<double>)> derive;
@@ -57,8 +57,10 @@ struct PersistentField {
 /// Values per element: 1 for a double, the size of a fixed-size Eigen vector or matrix.
 template <class T>
 constexpr int element_width() {
-  if constexpr (std::is_same_v<T, double>) return 1;
-  else return static_cast<int>(T::SizeAtCompileTime);
+  if constexpr (std::is_same_v<T, double>)
+    return 1;
+  else
+    return static_cast<int>(T::SizeAtCompileTime);
 }
 
 /// View a vector of fixed-size Eigen objects (or doubles) as doubles (stored without padding).
@@ -85,13 +87,23 @@ class FieldList {
   PersistentField& add(std::string name, std::vector<T>& v, const char* unit, FrameForm frame = FrameForm::none,
                        std::string frame_name = {}, std::string legacy_name = {},
                        double (*from_legacy)(double) = nullptr) {
-    return push({group_, std::move(name), element_width<T>(), unit, flat_doubles(v), true, frame,
-                 std::move(frame_name), 1 << 20, {}, std::move(legacy_name), from_legacy});
+    return push({group_,
+                 std::move(name),
+                 element_width<T>(),
+                 unit,
+                 flat_doubles(v),
+                 true,
+                 frame,
+                 std::move(frame_name),
+                 1 << 20,
+                 {},
+                 std::move(legacy_name),
+                 from_legacy});
   }
   PersistentField& add(std::string name, std::vector<std::uint8_t>& v, const char* unit,
                        FrameForm frame = FrameForm::none) {
-    return push({group_, std::move(name), 1, unit, std::span<std::uint8_t>(v), true, frame, {}, 1 << 20, {}, {},
-                 nullptr});
+    return push(
+        {group_, std::move(name), 1, unit, std::span<std::uint8_t>(v), true, frame, {}, 1 << 20, {}, {}, nullptr});
   }
   /// A fixed-size array of `width` doubles (one item; e.g. a rigid body's velocity).
   PersistentField& add_values(std::string name, std::span<double> values, const char* unit) {
@@ -100,8 +112,8 @@ class FieldList {
   }
   /// A scalar the frames compute from other fields (not in checkpoints).
   PersistentField& derived(std::string name, const char* unit, std::function<void(std::span<double>)> fill) {
-    return push({group_, std::move(name), 1, unit, {}, false, FrameForm::scalar, {}, 1 << 20, std::move(fill), {},
-                 nullptr});
+    return push(
+        {group_, std::move(name), 1, unit, {}, false, FrameForm::scalar, {}, 1 << 20, std::move(fill), {}, nullptr});
   }
   /// Show an already declared field of the current group in the frames, as `form`, under
   /// `frame_name` if given (e.g. the fluid law shows its body's phi, and its pressure as

@@ -30,8 +30,7 @@ struct PlaneStrain {
   static constexpr bool has_hoop_terms = false;
   static double measure(const Vec<dim>& /*x*/, double area) { return area; }
   /// 3×3 velocity gradient L [1/s] from Σ_i v_i ∇N_ipᵀ (ncomp × dim).
-  static Mat3 velocity_gradient(const Mat<ncomp, dim>& grad_v, const Vec<dim>& /*x*/,
-                                const Vec<ncomp>& /*v*/) {
+  static Mat3 velocity_gradient(const Mat<ncomp, dim>& grad_v, const Vec<dim>& /*x*/, const Vec<ncomp>& /*v*/) {
     Mat3 L = Mat3::Zero();
     L.topLeftCorner<2, 2>() = grad_v;
     return L;
@@ -54,8 +53,7 @@ struct ThreeD {
   static constexpr const char* name = "3d";
   static constexpr bool has_hoop_terms = false;
   static double measure(const Vec<dim>& /*x*/, double volume) { return volume; }
-  static Mat3 velocity_gradient(const Mat<ncomp, dim>& grad_v, const Vec<dim>& /*x*/,
-                                const Vec<ncomp>& /*v*/) {
+  static Mat3 velocity_gradient(const Mat<ncomp, dim>& grad_v, const Vec<dim>& /*x*/, const Vec<ncomp>& /*v*/) {
     return grad_v;
   }
 };

@@ -64,8 +64,7 @@ class GranularBodyLaw final : public StressLaw<G> {
         for (int e : {2, 5, 6, 7})
           assert(body.stress_Pa[q0 + i].data()[e] == 0.0 && body.L_1_s[q0 + i].data()[e] == 0.0);
 #endif
-    law_.advance_batch(m, body.stress_Pa.data() + q0, f.data() + q0, body.L_1_s.data() + q0, phi, dt_s, step,
-                       kInPlane);
+    law_.advance_batch(m, body.stress_Pa.data() + q0, f.data() + q0, body.L_1_s.data() + q0, phi, dt_s, step, kInPlane);
     std::int64_t first_bad = kAllFinite;
     for (std::int64_t i = 0; i < m; ++i) {
       if (!step[i].ok) {
@@ -120,9 +119,9 @@ class GranularBodyLaw final : public StressLaw<G> {
     list.add("gamma_dot_p", gamma_dot_p, "1/s", FrameForm::scalar);
   }
 
-  std::vector<double> f;                 ///< micro-structure per point
-  std::vector<std::uint8_t> regime;      ///< material::GranularRegime of the last step
-  std::vector<double> gamma_dot_p;       ///< plastic shear rate of the last step [1/s]
+  std::vector<double> f;             ///< micro-structure per point
+  std::vector<std::uint8_t> regime;  ///< material::GranularRegime of the last step
+  std::vector<double> gamma_dot_p;   ///< plastic shear rate of the last step [1/s]
 
  private:
   static constexpr std::int64_t kChunk = 256;  ///< points per chunk

@@ -31,14 +31,13 @@ template <int D>
 struct Grid {
   static constexpr int kGhost = 2;
 
-  Vec<D> origin_m = Vec<D>::Zero();   ///< [m] lower corner of the physical domain
-  double h_m = 1.0;                   ///< [m] cell size (same on every axis)
-  std::array<int, D> cells{};         ///< cells per axis
-  std::array<bool, D> periodic{};     ///< periodic axes
+  Vec<D> origin_m = Vec<D>::Zero();  ///< [m] lower corner of the physical domain
+  double h_m = 1.0;                  ///< [m] cell size (same on every axis)
+  std::array<int, D> cells{};        ///< cells per axis
+  std::array<bool, D> periodic{};    ///< periodic axes
 
   Grid() = default;
-  Grid(const Vec<D>& origin, double h, const std::array<int, D>& n_cells,
-       const std::array<bool, D>& periodic_axes = {})
+  Grid(const Vec<D>& origin, double h, const std::array<int, D>& n_cells, const std::array<bool, D>& periodic_axes = {})
       : origin_m(origin), h_m(h), cells(n_cells), periodic(periodic_axes) {}
 
   /// Stored nodes along axis a.

@@ -30,8 +30,7 @@ class LinearElasticLaw final : public StressLaw<G> {
   double max_wave_speed(const Body<G>& body) const override {
     // c = √(M/ρ) at the lightest point (current density m/V), the fastest wave.
     double rho_min = INFINITY;
-    for (std::int64_t q = 0; q < body.size(); ++q)
-      rho_min = std::min(rho_min, body.mass_kg[q] / body.volume_m3[q]);
+    for (std::int64_t q = 0; q < body.size(); ++q) rho_min = std::min(rho_min, body.mass_kg[q] / body.volume_m3[q]);
     return body.size() > 0 ? std::sqrt(p_.p_wave_modulus_Pa() / rho_min) : 0.0;
   }
   const char* name() const override { return "linear_elastic"; }

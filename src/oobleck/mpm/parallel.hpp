@@ -116,7 +116,8 @@ class StealingShares {
     if (next_.size() < need) next_ = std::vector<Counter>(need);
   }
   void start(int set, std::int64_t n) {
-    for (int u = 0; u < team_; ++u) next_[index(set, u)].next.store(share_begin(n, team_, u), std::memory_order_relaxed);
+    for (int u = 0; u < team_; ++u)
+      next_[index(set, u)].next.store(share_begin(n, team_, u), std::memory_order_relaxed);
   }
   /// f(begin, end) over the calling thread's share of set `set` (n units, as given to start), then
   /// over the others' remaining units.

@@ -27,8 +27,10 @@ auto floor_of(const A& x) {
 }
 template <class T>
 T constant(double v) {
-  if constexpr (std::is_same_v<T, double>) return v;
-  else return T::Constant(v);
+  if constexpr (std::is_same_v<T, double>)
+    return v;
+  else
+    return T::Constant(v);
 }
 }  // namespace kernel_detail
 
@@ -173,7 +175,8 @@ template <int D, int S, class F>
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void for_each_node(const Stencil<D, S>& s, F&& f) {
+inline void
+for_each_node(const Stencil<D, S>& s, F&& f) {
   static_assert(D >= 1 && D <= 3 && S >= 1 && S <= kMaxSupport);
   if constexpr (D == 1) {
     for (int j0 = 0; j0 < S; ++j0) {
@@ -281,15 +284,21 @@ struct ShapeCache {
   template <int Sk>
   const std::vector<Stencil<D, Sk>>& stencils() const {
     static_assert(Sk >= 2 && Sk <= kMaxSupport);
-    if constexpr (Sk == 2) return stencil2_;
-    else if constexpr (Sk == 3) return stencil3_;
-    else return stencil4_;
+    if constexpr (Sk == 2)
+      return stencil2_;
+    else if constexpr (Sk == 3)
+      return stencil3_;
+    else
+      return stencil4_;
   }
   template <class F>
   void with_support(F&& f) {
-    if (S == 2) f(stencil2_);
-    else if (S == 3) f(stencil3_);
-    else f(stencil4_);
+    if (S == 2)
+      f(stencil2_);
+    else if (S == 3)
+      f(stencil3_);
+    else
+      f(stencil4_);
   }
   /// f(stencil of p, per-axis indices of local node k), the last axis fastest.
   template <class F>
@@ -324,7 +333,9 @@ struct StencilGrid {
 /// Whether a kernel evaluates all axes at once on Eigen arrays (`axes`); the others go axis by axis.
 template <class Kernel, int D>
 concept AxesKernel = requires(const Kernel& k, const Eigen::Array<double, D, 1>& xi, Eigen::Array<double, D, 1>& b,
-                              Eigen::Array<double, D, 1>* w) { k.axes(xi, b, w, w); };
+                              Eigen::Array<double, D, 1>* w) {
+  k.axes(xi, b, w, w);
+};
 
 /// The stencil of a point at x and the diagonal of APIC's D_p⁻¹ [1/m²]. Returns false when the
 /// support leaves the stored nodes (non-periodic axes; those indices are set to 0).
@@ -336,8 +347,9 @@ template <int D, class Kernel>
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline bool make_stencil(const Grid<D>& grid, const StencilGrid<D>& sg, const Kernel& kernel, const Vec<D>& x,
-                         Stencil<D, Kernel::support>& s, Vec<D>& inv_D) {
+inline bool
+make_stencil(const Grid<D>& grid, const StencilGrid<D>& sg, const Kernel& kernel, const Vec<D>& x,
+             Stencil<D, Kernel::support>& s, Vec<D>& inv_D) {
   constexpr int S = Kernel::support;
   using A = Eigen::Array<double, D, 1>;
   A xi, basef, w[S], dw[S];

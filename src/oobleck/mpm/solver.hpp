@@ -43,10 +43,10 @@ enum class Phase { Solid, Grains, Fluid };
 /// with a Grains body as well).
 template <class G>
 struct MixtureOptions {
-  double rho_s_kg_m3 = 1620.0;     ///< grain true density ρ_s
-  double rho_f0_kg_m3 = 1000.0;    ///< fluid rest density ρ_f0 (Re uses the nodal ρ_f)
-  double min_porosity = 0.01;      ///< lower clamp of the nodal porosity n_i [base]
-  material::DragParams drag;       ///< E29 (d, η_0, law)
+  double rho_s_kg_m3 = 1620.0;   ///< grain true density ρ_s
+  double rho_f0_kg_m3 = 1000.0;  ///< fluid rest density ρ_f0 (Re uses the nodal ρ_f)
+  double min_porosity = 0.01;    ///< lower clamp of the nodal porosity n_i [base]
+  material::DragParams drag;     ///< E29 (d, η_0, law)
   /// Imposed uniform background pressure gradient ∇p_0 [Pa/m], split like the fluid pressure
   /// (grains (1−n), fluid n). Periodic boxes use ∇p_0 = ρ_mix g to carry the mixture's weight.
   Vec<G::ncomp> background_pressure_gradient_Pa_m = Vec<G::ncomp>::Zero();
@@ -54,14 +54,14 @@ struct MixtureOptions {
 
 template <class G>
 struct SolverOptions {
-  double dt_s = 1e-5;                                   ///< time step [s]
-  ShapeKind shape = ShapeKind::QuadraticBSpline;        ///< shape functions
-  double gimp_half_width_cells = 0.25;                  ///< uGIMP ℓ in cells (= 1/(2 ppc))
-  Transfer transfer = Transfer::Apic;                   ///< velocity transfer
-  double flip_fraction = 0.99;                          ///< α of the FLIP/PIC blend
-  Vec<G::ncomp> gravity_m_s2 = Vec<G::ncomp>::Zero();   ///< gravitational acceleration
-  int threads = 0;                                      ///< OpenMP threads (0: omp default)
-  MixtureOptions<G> mixture;                            ///< used when a Fluid body exists
+  double dt_s = 1e-5;                                  ///< time step [s]
+  ShapeKind shape = ShapeKind::QuadraticBSpline;       ///< shape functions
+  double gimp_half_width_cells = 0.25;                 ///< uGIMP ℓ in cells (= 1/(2 ppc))
+  Transfer transfer = Transfer::Apic;                  ///< velocity transfer
+  double flip_fraction = 0.99;                         ///< α of the FLIP/PIC blend
+  Vec<G::ncomp> gravity_m_s2 = Vec<G::ncomp>::Zero();  ///< gravitational acceleration
+  int threads = 0;                                     ///< OpenMP threads (0: omp default)
+  MixtureOptions<G> mixture;                           ///< used when a Fluid body exists
 };
 
 /// Phase 6 for one body, by the calling thread of a region: G2P's blocks of `task` in static
@@ -125,10 +125,9 @@ class Solver {
     if (!(opt_.dt_s > 0.0)) throw InputError(fmt::format("mpm: dt must be > 0 s, got {}", opt_.dt_s));
     if (!(opt_.flip_fraction >= 0.0 && opt_.flip_fraction <= 1.0))
       throw InputError(fmt::format("mpm: flip_fraction must be in [0, 1], got {}", opt_.flip_fraction));
-    if (opt_.shape == ShapeKind::UGimp &&
-        !(opt_.gimp_half_width_cells > 0.0 && opt_.gimp_half_width_cells <= 0.5))
-      throw InputError(fmt::format("mpm: uGIMP half width must be in (0, 0.5] cells, got {}",
-                                   opt_.gimp_half_width_cells));
+    if (opt_.shape == ShapeKind::UGimp && !(opt_.gimp_half_width_cells > 0.0 && opt_.gimp_half_width_cells <= 0.5))
+      throw InputError(
+          fmt::format("mpm: uGIMP half width must be in (0, 0.5] cells, got {}", opt_.gimp_half_width_cells));
     threads_ = opt_.threads > 0 ? opt_.threads : parallel::max_threads();
   }
 
@@ -208,7 +207,8 @@ class Solver {
     } else {
       check_solid(b, "motor");
       if (rigid_[b].rigid()) throw InputError("mpm: a motor drives a deformable body");
-      if (!(gain > 0.0 && gain <= 1.0)) throw InputError(fmt::format("mpm: motor gain must be in (0, 1], got {}", gain));
+      if (!(gain > 0.0 && gain <= 1.0))
+        throw InputError(fmt::format("mpm: motor gain must be in (0, 1], got {}", gain));
       motors_.push_back({});
       motors_.back().body = b;
       motors_.back().omega_rad_s = omega_rad_s;
@@ -255,10 +255,10 @@ class Solver {
   void check_time_step(double cfl = 0.5) const {
     const double dt_max = stable_dt(cfl);
     if (opt_.dt_s > dt_max)
-      throw InputError(fmt::format(
-          "mpm: time step dt = {:.4g} s is above the stable limit {:.4g} s (CFL {} on the fastest "
-          "wave, viscous limit rho h^2/(2 eta), h = {:.4g} m)",
-          opt_.dt_s, dt_max, cfl, grid_.h_m));
+      throw InputError(
+          fmt::format("mpm: time step dt = {:.4g} s is above the stable limit {:.4g} s (CFL {} on the fastest "
+                      "wave, viscous limit rho h^2/(2 eta), h = {:.4g} m)",
+                      opt_.dt_s, dt_max, cfl, grid_.h_m));
   }
 
   /// One explicit step of length options().dt_s, in the phases of docs/mpm.md ("The step").
@@ -266,18 +266,18 @@ class Solver {
     with_support([&](auto S) {
       constexpr int K = ipow(decltype(S)::value, D);
       StepClock clock(timings_);
-      apply_motors();                // 1. motors: velocity-level drive of driven bodies (§8)
-      particles_to_grid_all<K>();    // 2. P2G: shape functions, mass, momentum, forces, gravity
+      apply_motors();              // 1. motors: velocity-level drive of driven bodies (§8)
+      particles_to_grid_all<K>();  // 2. P2G: shape functions, mass, momentum, forces, gravity
       clock.lap(timings_.p2g);
       prepare_contact_arrays();
-      update_grid_and_couple(        // 3. grid: walls fold ghosts, rigid predictions; porosity,
+      update_grid_and_couple(                           // 3. grid: walls fold ghosts, rigid predictions; porosity,
           [this] { scatter_contact_gradients<K>(); });  // buoyancy (E28), v = (mv + Δt f)/m,
-                                     //    drag (E29); beside it, contact's mass gradients
-      resolve_contacts();            // 4. contact impulses (§8), rigid bodies' velocities
+                                                        //    drag (E29); beside it, contact's mass gradients
+      resolve_contacts();                               // 4. contact impulses (§8), rigid bodies' velocities
       clock.lap(timings_.grid);
-      update_points<K>(clock);       // 5. walls on nodal velocities, mixture flux q (E27);
-                                     // 6. G2P: x, v (APIC or FLIP/PIC), C, L, V ← V exp(Δt tr L);
-                                     // 7. laws: stresses (and their state) from L
+      update_points<K>(clock);  // 5. walls on nodal velocities, mixture flux q (E27);
+                                // 6. G2P: x, v (APIC or FLIP/PIC), C, L, V ← V exp(Δt tr L);
+                                // 7. laws: stresses (and their state) from L
     });
     time_s_ += opt_.dt_s;
     ++steps_;
@@ -347,10 +347,10 @@ class Solver {
     });
     for (int b = 0; b < nb; ++b)
       if (p2g_outside_[b] > 0)
-        throw NumericalError(fmt::format(
-            "mpm: {} point(s) of body '{}' left the grid (more than one cell outside the domain) at "
-            "step {}, t = {} s",
-            p2g_outside_[b], bodies_[b]->name, steps_, time_s_));
+        throw NumericalError(
+            fmt::format("mpm: {} point(s) of body '{}' left the grid (more than one cell outside the domain) at "
+                        "step {}, t = {} s",
+                        p2g_outside_[b], bodies_[b]->name, steps_, time_s_));
   }
 
   bool mixture() const { return grains_ >= 0 && fluid_ >= 0; }
@@ -548,8 +548,8 @@ class Solver {
       RigidMotion<G>& rm = rigid_[c.solid];
       const Vec<D>* mix_grad = c.combined_normal ? mixture_gradient_.data() : nullptr;
       if (rm.kind == BodyMotion::FreeRigid && rm.mass_kg > 0.0) {  // whole-body solve
-        const Vec<NC> J = resolve_rigid_contact(c, rm, fields_[c.solid], grains, fluid, contact_weight_,
-                                                mixture_volume, node_measure_, mix_grad, opt_.dt_s);
+        const Vec<NC> J = resolve_rigid_contact(c, rm, fields_[c.solid], grains, fluid, contact_weight_, mixture_volume,
+                                                node_measure_, mix_grad, opt_.dt_s);
         rm.velocity_m_s += J.cwiseProduct(rm.free_mask) / rm.mass_kg;
       } else {  // deformable or prescribed: node by node
         resolve_contact(c, rm, fields_[c.solid], grains, fluid, contact_weight_, mixture_volume, node_measure_,
@@ -564,8 +564,7 @@ class Solver {
   }
 
   void check_solid(int b, const char* what) const {
-    if (b < 0 || b >= body_count())
-      throw InputError(fmt::format("mpm: {}: no body with index {}", what, b));
+    if (b < 0 || b >= body_count()) throw InputError(fmt::format("mpm: {}: no body with index {}", what, b));
     if (b == grains_ || b == fluid_)
       throw InputError(fmt::format("mpm: {}: body '{}' is a mixture phase, not a solid", what, bodies_[b]->name));
   }
@@ -601,8 +600,8 @@ class Solver {
         const GridField<G>& field = fields_[b];
         bool none = true;
         for (int i = i0; i < i1; ++i)
-          none &= (field.velocity[i][2] == 0.0) & (field.velocity_old[i][2] == 0.0) &
-                  (b != fluid_ || flux_[i][2] == 0.0);
+          none &=
+              (field.velocity[i][2] == 0.0) & (field.velocity_old[i][2] == 0.0) & (b != fluid_ || flux_[i][2] == 0.0);
         if (!none) swirl |= std::uint64_t{1} << k;
       }
       // (bodies past the 64th keep the general kernels: the same values)
@@ -620,10 +619,10 @@ class Solver {
     g2p_tasks_.clear();
     for (int k = 0; k < ntasks; ++k) {
       const int b = g2p_bodies_[k];
-      g2p_tasks_.push_back(make_g2p_task<G, K>(
-          *bodies_[b], caches_[b], fields_[b], grid_, opt_.transfer, opt_.flip_fraction, opt_.dt_s,
-          b == fluid_ ? porosity_.data() : nullptr, b == fluid_ ? flux_.data() : nullptr,
-          G::has_hoop_terms && (swirl >> std::min(k, 63) & 1u) == 0));
+      g2p_tasks_.push_back(make_g2p_task<G, K>(*bodies_[b], caches_[b], fields_[b], grid_, opt_.transfer,
+                                               opt_.flip_fraction, opt_.dt_s, b == fluid_ ? porosity_.data() : nullptr,
+                                               b == fluid_ ? flux_.data() : nullptr,
+                                               G::has_hoop_terms && (swirl >> std::min(k, 63) & 1u) == 0));
     }
     shares_.resize(ntasks + static_cast<int>(law_bodies_.size()), team);
     for (int k = 0; k < ntasks; ++k) shares_.start(k, g2p_tasks_[k].blocks);
@@ -735,7 +734,8 @@ class Solver {
   int threads_ = 1;
   int grains_ = -1, fluid_ = -1;
   StepTimings timings_;
-  std::vector<GridField<G>*> solids_;  ///< scratch of update_grid_and_couple (refilled per call): deformable solids' fields
+  std::vector<GridField<G>*>
+      solids_;                    ///< scratch of update_grid_and_couple (refilled per call): deformable solids' fields
   std::vector<double> porosity_;  ///< nodal porosity n_i of the mixture
   std::vector<Vec<NC>> flux_;     ///< nodal mixture volume flux q_i
   // scratch of update_points (refilled per call): the G2P tasks of the deformable bodies and

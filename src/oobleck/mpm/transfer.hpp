@@ -109,7 +109,8 @@ template <class G, bool Split>
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline P2GPointTerms<G::dim> p2g_point_terms(const Body<G>& body, std::int64_t p) {
+inline P2GPointTerms<G::dim>
+p2g_point_terms(const Body<G>& body, std::int64_t p) {
   constexpr int D = G::dim, NC = G::ncomp;
   P2GPointTerms<D> t;
   const double mp = body.mass_kg[p], Vp = body.volume_m3[p];
@@ -118,7 +119,7 @@ inline P2GPointTerms<G::dim> p2g_point_terms(const Body<G>& body, std::int64_t p
   double Vpres = 0.0;
   if constexpr (Split) {
     const double pres = -sig.trace() * (1.0 / 3.0);  // × 1/3, not ÷ 3: no division latency per point
-    sig.diagonal().array() += pres;  // τ = σ + p 1
+    sig.diagonal().array() += pres;                  // τ = σ + p 1
     Vpres = Vp * pres;
   }
   double Vsig[D][NC], Cp[D][NC], v[NC], fpt[NC], fppt[NC];
@@ -171,8 +172,9 @@ template <class G, int K, bool Apic, bool Split, bool NoSwirl>
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void p2g_scatter_point_2d(const P2GPointTerms<G::dim>& t, const ShapeCache<G::dim>& cache, std::int64_t p, double* m,
-                        double* mv, double* f, double* fp, double* vol) {
+inline void
+p2g_scatter_point_2d(const P2GPointTerms<G::dim>& t, const ShapeCache<G::dim>& cache, std::int64_t p, double* m,
+                     double* mv, double* f, double* fp, double* vol) {
   constexpr int D = G::dim, NC = G::ncomp, S = support_of<D>(K);
   constexpr bool kTheta = NC == 3 && !NoSwirl;  // the third component's nodal terms
   const double mp = t.mp, Vp = t.Vp, Vpres = t.Vpres;
@@ -209,19 +211,22 @@ inline void p2g_scatter_point_2d(const P2GPointTerms<G::dim>& t, const ShapeCach
       double* fi = f + static_cast<std::int64_t>(i) * NC;
       m[i] += P * w1;
       Eigen::Map<V2> mvi2(mvi), fi2(fi);
-      if constexpr (Apic) mvi2 += a1.w[j1].cwiseProduct(U2) + a1.wo[j1].cwiseProduct(Vc2);
-      else mvi2 += a1.w[j1].cwiseProduct(U2);
+      if constexpr (Apic)
+        mvi2 += a1.w[j1].cwiseProduct(U2) + a1.wo[j1].cwiseProduct(Vc2);
+      else
+        mvi2 += a1.w[j1].cwiseProduct(U2);
       fi2 += a1.w[j1].cwiseProduct(E2) + a1.dw[j1].cwiseProduct(nB2);
       if constexpr (kTheta) {
-        if constexpr (Apic) mvi[2] += w1 * U3 + (w1 * st.off[j1][1]) * Vc3;
-        else mvi[2] += w1 * U3;
+        if constexpr (Apic)
+          mvi[2] += w1 * U3 + (w1 * st.off[j1][1]) * Vc3;
+        else
+          mvi[2] += w1 * U3;
         fi[2] += w1 * E3 + dw1 * nB3;
       }
       if constexpr (Split) {
         double* fpi = fp + static_cast<std::int64_t>(i) * NC;
-        Eigen::Map<V2>(fpi) += PV2.cwiseProduct(a1.w_dw[j1]);  // V_p p (N'_0 N_1, N_0 N'_1)
-        if constexpr (G::has_hoop_terms)
-          fpi[0] += w1 * (w0 * fppt[0]);  // (its z and θ entries are zeros: left out)
+        Eigen::Map<V2>(fpi) += PV2.cwiseProduct(a1.w_dw[j1]);            // V_p p (N'_0 N_1, N_0 N'_1)
+        if constexpr (G::has_hoop_terms) fpi[0] += w1 * (w0 * fppt[0]);  // (its z and θ entries are zeros: left out)
         vol[i] += (w0 * Vp) * w1;
       }
     }
@@ -233,8 +238,9 @@ template <class G, int K, bool Apic, bool Split, bool NoSwirl>
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void p2g_scatter_point_general(const P2GPointTerms<G::dim>& t, const ShapeCache<G::dim>& cache, std::int64_t p, double* m,
-                        double* mv, double* f, double* fp, double* vol) {
+inline void
+p2g_scatter_point_general(const P2GPointTerms<G::dim>& t, const ShapeCache<G::dim>& cache, std::int64_t p, double* m,
+                          double* mv, double* f, double* fp, double* vol) {
   constexpr int D = G::dim, NC = G::ncomp, S = support_of<D>(K);
   const double mp = t.mp, Vp = t.Vp, Vpres = t.Vpres;
   const V2 *Vsig2 = t.Vsig2, *Cp2 = t.Cp2;
@@ -300,19 +306,22 @@ template <class G, int K, bool Apic, bool Split, bool NoSwirl = false>
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void particles_to_grid_point_inlined(const Body<G>& body, const ShapeCache<G::dim>& cache, std::int64_t p,
-                                            double* m, double* mv, double* f, double* fp, double* vol) {
+inline void
+particles_to_grid_point_inlined(const Body<G>& body, const ShapeCache<G::dim>& cache, std::int64_t p, double* m,
+                                double* mv, double* f, double* fp, double* vol) {
   static_assert(!NoSwirl || G::has_hoop_terms);
   const P2GPointTerms<G::dim> t = p2g_point_terms<G, Split>(body, p);
-  if constexpr (G::dim == 2) p2g_scatter_point_2d<G, K, Apic, Split, NoSwirl>(t, cache, p, m, mv, f, fp, vol);
-  else p2g_scatter_point_general<G, K, Apic, Split, NoSwirl>(t, cache, p, m, mv, f, fp, vol);
+  if constexpr (G::dim == 2)
+    p2g_scatter_point_2d<G, K, Apic, Split, NoSwirl>(t, cache, p, m, mv, f, fp, vol);
+  else
+    p2g_scatter_point_general<G, K, Apic, Split, NoSwirl>(t, cache, p, m, mv, f, fp, vol);
 }
 
 /// particles_to_grid_point_inlined behind a call that GCC may or may not inline (the
 /// axisymmetric kernels' P2G; the tests' reference).
 template <class G, int K, bool Apic, bool Split, bool NoSwirl = false>
-inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim>& cache, std::int64_t p,
-                                    double* m, double* mv, double* f, double* fp, double* vol) {
+inline void particles_to_grid_point(const Body<G>& body, const ShapeCache<G::dim>& cache, std::int64_t p, double* m,
+                                    double* mv, double* f, double* fp, double* vol) {
   particles_to_grid_point_inlined<G, K, Apic, Split, NoSwirl>(body, cache, p, m, mv, f, fp, vol);
 }
 
@@ -325,8 +334,8 @@ inline bool point_without_swirl(const Body<G>& body, std::int64_t p) {
   const Mat3& s = body.stress_Pa[p];
   const auto& C = body.C_1_s[p];
   auto bits = [](double x) { return std::bit_cast<std::uint64_t>(x); };
-  const std::uint64_t any = bits(body.v_m_s[p][2]) | bits(C(2, 0)) | bits(C(2, 1)) | bits(s(2, 0)) |
-                            bits(s(2, 1)) | bits(s(0, 2)) | bits(body.f_ext_N[p][2]);
+  const std::uint64_t any = bits(body.v_m_s[p][2]) | bits(C(2, 0)) | bits(C(2, 1)) | bits(s(2, 0)) | bits(s(2, 1)) |
+                            bits(s(0, 2)) | bits(body.f_ext_N[p][2]);
   return (any << 1) == 0;
 }
 
@@ -394,11 +403,15 @@ std::int64_t p2g_scatter_range(const Body<G>& body, const Grid<G::dim>& grid, co
     }
   };
   if (apic) {
-    if (split_pressure) scatter.template operator()<true, true>();
-    else scatter.template operator()<true, false>();
+    if (split_pressure)
+      scatter.template operator()<true, true>();
+    else
+      scatter.template operator()<true, false>();
   } else {
-    if (split_pressure) scatter.template operator()<false, true>();
-    else scatter.template operator()<false, false>();
+    if (split_pressure)
+      scatter.template operator()<false, true>();
+    else
+      scatter.template operator()<false, false>();
   }
   return bad;
 }
@@ -475,8 +488,8 @@ struct G2PArgs {
   const Grid<G::dim>* grid = nullptr;
   double alpha = 1.0;  ///< FLIP fraction (FLIP/PIC blend only)
   double dt_s = 0.0;
-  const double* porosity = nullptr;              ///< n_i (the mixture's fluid only)
-  const Vec<G::ncomp>* mixture_flux = nullptr;   ///< q_i (the mixture's fluid only)
+  const double* porosity = nullptr;             ///< n_i (the mixture's fluid only)
+  const Vec<G::ncomp>* mixture_flux = nullptr;  ///< q_i (the mixture's fluid only)
 };
 
 /// G2P of one body as independent blocks of numerics::kMathBlock points, its kernel chosen once
@@ -517,11 +530,12 @@ template <class G, int K, bool Apic, bool ByGrad, bool Mixture, bool NoSwirl>
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void accumulate_g2p(const ShapeCache<G::dim>& cache, std::int64_t p, const double* vel, const double* vel_old,
-                           const double* flux, const double* porosity, G2PSums<G::dim>& s) {
+inline void
+accumulate_g2p(const ShapeCache<G::dim>& cache, std::int64_t p, const double* vel, const double* vel_old,
+               const double* flux, const double* porosity, G2PSums<G::dim>& s) {
   constexpr int D = G::dim, NC = G::ncomp, S = support_of<D>(K);
   constexpr bool kTheta = NC == 3 && !NoSwirl;  // the third component's sums over the nodes
-  (void)vel_old, (void)flux, (void)porosity;   // (read by the FLIP and mixture kernels only)
+  (void)vel_old, (void)flux, (void)porosity;    // (read by the FLIP and mixture kernels only)
   if constexpr (D == 2) {
     // The tensor product factorised (as in P2G): per row j0 the sums over j1 of N_1 v_i,
     // N'_1 v_i and N_1 o_1 v_i, then ∑N v = ∑ N_0 (∑N_1 v), ∇: (∑ N'_0 (∑N_1 v), ∑ N_0 (∑N'_1 v)),
@@ -641,8 +655,8 @@ template <class G, bool Apic, bool ByGrad, bool Mixture>
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void write_back_g2p_2d(const G2PArgs<G>& args, std::int64_t p, G2PSums<G::dim>& s, double& vol_arg,
-                           double& kin_sum) {
+inline void
+write_back_g2p_2d(const G2PArgs<G>& args, std::int64_t p, G2PSums<G::dim>& s, double& vol_arg, double& kin_sum) {
   constexpr int D = G::dim, NC = G::ncomp;
   Body<G>& body = *args.body;
   const Grid<G::dim>& grid = *args.grid;
@@ -714,8 +728,8 @@ template <class G, bool Apic, bool ByGrad, bool Mixture>
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void write_back_g2p_general(const G2PArgs<G>& args, std::int64_t p, G2PSums<G::dim>& s, double& vol_arg,
-                           double& kin_sum) {
+inline void
+write_back_g2p_general(const G2PArgs<G>& args, std::int64_t p, G2PSums<G::dim>& s, double& vol_arg, double& kin_sum) {
   constexpr int D = G::dim, NC = G::ncomp;
   Body<G>& body = *args.body;
   const Grid<G::dim>& grid = *args.grid;
@@ -725,7 +739,7 @@ inline void write_back_g2p_general(const G2PArgs<G>& args, std::int64_t p, G2PSu
   Vec<NC>* const vs = body.v_m_s.data();
   Mat<NC, D>* const Cs = body.C_1_s.data();
   Mat3* const Ls = body.L_1_s.data();
-  (void)alpha, (void)inv_D, (void)Cs;  // (FLIP reads alpha; APIC inv_D and C)
+  (void)alpha, (void)inv_D, (void)Cs;                          // (FLIP reads alpha; APIC inv_D and C)
   double v_pic[NC], dv[NC], q_p[NC], grad_v[D][NC], B[D][NC];  // column-major like Mat<NC, D>
   for (int c = 0; c < 2; ++c) {
     v_pic[c] = s.vp2[c];
@@ -789,10 +803,12 @@ template <class G, bool Apic, bool ByGrad, bool Mixture>
 #if defined(__GNUC__)
 [[gnu::always_inline]]
 #endif
-inline void write_back_g2p(const G2PArgs<G>& args, std::int64_t p, G2PSums<G::dim>& s, double& vol_arg,
-                           double& kin_sum) {
-  if constexpr (G::dim == 2) write_back_g2p_2d<G, Apic, ByGrad, Mixture>(args, p, s, vol_arg, kin_sum);
-  else write_back_g2p_general<G, Apic, ByGrad, Mixture>(args, p, s, vol_arg, kin_sum);
+inline void
+write_back_g2p(const G2PArgs<G>& args, std::int64_t p, G2PSums<G::dim>& s, double& vol_arg, double& kin_sum) {
+  if constexpr (G::dim == 2)
+    write_back_g2p_2d<G, Apic, ByGrad, Mixture>(args, p, s, vol_arg, kin_sum);
+  else
+    write_back_g2p_general<G, Apic, ByGrad, Mixture>(args, p, s, vol_arg, kin_sum);
 }
 
 /// G2P for one body with the per-point branches resolved at compile time (APIC or FLIP/PIC,
@@ -887,7 +903,8 @@ G2PTask<G> make_g2p_task(Body<G>& body, const ShapeCache<G::dim>& cache, const G
   const bool mix = porosity != nullptr;
   const bool no_swirl = no_swirl_known ? *no_swirl_known : g2p_without_swirl(field, mix ? mixture_flux : nullptr);
   G2PTask<G> task;
-  task.args = {&body, &cache, &field, &grid, flip_fraction, dt_s, mix ? porosity : nullptr, mix ? mixture_flux : nullptr};
+  task.args = {
+      &body, &cache, &field, &grid, flip_fraction, dt_s, mix ? porosity : nullptr, mix ? mixture_flux : nullptr};
   task.blocks = (body.size() + numerics::kMathBlock - 1) / numerics::kMathBlock;
   auto pick = [&]<bool A, bool BG>() {
     auto with = [&]<bool NS>() {
@@ -909,10 +926,10 @@ G2PTask<G> make_g2p_task(Body<G>& body, const ShapeCache<G::dim>& cache, const G
 
 // The axisymmetric G2P is compiled in its own translation unit, transfer_axisymmetric.cpp, with
 // 128-bit auto-vectorisation (see there and docs/mpm.md "Performance"); the other units use it.
-#define OOBLECK_AXISYMMETRIC_G2P(KIND, K)                                                                  \
-  KIND template G2PTask<Axisymmetric> make_g2p_task<Axisymmetric, K>(                                      \
-      Body<Axisymmetric>&, const ShapeCache<2>&, const GridField<Axisymmetric>&, const Grid<2>&, Transfer, \
-      double, double, const double*, const Vec<3>*, std::optional<bool>);
+#define OOBLECK_AXISYMMETRIC_G2P(KIND, K)                                                                          \
+  KIND template G2PTask<Axisymmetric> make_g2p_task<Axisymmetric, K>(                                              \
+      Body<Axisymmetric>&, const ShapeCache<2>&, const GridField<Axisymmetric>&, const Grid<2>&, Transfer, double, \
+      double, const double*, const Vec<3>*, std::optional<bool>);
 OOBLECK_AXISYMMETRIC_G2P(extern, 4)
 OOBLECK_AXISYMMETRIC_G2P(extern, 9)
 OOBLECK_AXISYMMETRIC_G2P(extern, 16)

@@ -16,8 +16,8 @@ struct RootResult {
 /// `fdf(x, f, df)` evaluates F and F'. Converges when the bracket or the step is below
 /// rel_tol * max(|x|, abs_floor).
 template <class FdF>
-RootResult newton_bracketed(FdF&& fdf, double lo, double hi, double rel_tol = 1e-13,
-                            double abs_floor = 1e-300, int max_iter = 100) {
+RootResult newton_bracketed(FdF&& fdf, double lo, double hi, double rel_tol = 1e-13, double abs_floor = 1e-300,
+                            int max_iter = 100) {
   RootResult r;
   double flo = 0.0, fhi = 0.0, d = 0.0;
   fdf(lo, flo, d);
@@ -31,7 +31,10 @@ RootResult newton_bracketed(FdF&& fdf, double lo, double hi, double rel_tol = 1e
     double fx = 0.0, dfx = 0.0;
     fdf(x, fx, dfx);
     if (fx == 0.0) return {x, r.iterations, true};
-    if ((fx < 0.0) == increasing) lo = x; else hi = x;
+    if ((fx < 0.0) == increasing)
+      lo = x;
+    else
+      hi = x;
     double next = (dfx != 0.0) ? x - fx / dfx : 0.5 * (lo + hi);
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);  // safeguard (also catches NaN)
     const double tol = rel_tol * std::fmax(std::fabs(next), abs_floor);

@@ -15,8 +15,6 @@ inline double f_jam(const SteadyParams& p, double phi) { return (p.phi_j - phi) 
 
 /// phi_m(f) - phi, computed from the gap to f_jam so that it stays accurate as f -> f_jam:
 /// phi_m - phi = (phi_j - phi_c) (f_jam - f).
-inline double phi_m_gap(const SteadyParams& p, double f_jam_minus_f) {
-  return (p.phi_j - p.phi_c) * f_jam_minus_f;
-}
+inline double phi_m_gap(const SteadyParams& p, double f_jam_minus_f) { return (p.phi_j - p.phi_c) * f_jam_minus_f; }
 
 }  // namespace oobleck::rheology

@@ -118,11 +118,11 @@ ceres::Solver::Options solver_options(const FitOptions& options) {
 /// Throws NumericalError unless Ceres reports convergence to a usable solution.
 void require_convergence(const ceres::Solver::Summary& s, FitKind kind, const FitOptions& options) {
   if (s.termination_type != ceres::CONVERGENCE || !std::isfinite(s.final_cost)) {
-    throw NumericalError(fmt::format(
-        "{}: the {} fit did not converge after {} iterations ({}: {}); check that the data follow the "
-        "model's asymptote (E12/E13/E14) and that the base parameter set suits them",
-        options.where, to_string(kind), s.iterations.size(), ceres::TerminationTypeToString(s.termination_type),
-        s.message));
+    throw NumericalError(
+        fmt::format("{}: the {} fit did not converge after {} iterations ({}: {}); check that the data follow the "
+                    "model's asymptote (E12/E13/E14) and that the base parameter set suits them",
+                    options.where, to_string(kind), s.iterations.size(),
+                    ceres::TerminationTypeToString(s.termination_type), s.message));
   }
 }
 
@@ -163,8 +163,8 @@ void fill_statistics(FitResult& r, const ceres::Solver::Summary& s) {
 /// Initial guess from the data alone. Where the friction term of E12/E13 dominates,
 /// phi/sqrt(eta_r - 1 - 5 phi/2) ~ (phi_m - phi)/(a sqrt(2 mu_c)) is linear in phi: its root is
 /// phi_m. With phi_m fixed, each point gives a by inverting E12/E13 exactly; take the median.
-void viscosity_guess(const std::vector<double>& phi, const std::vector<double>& eta_r, double mu_c,
-                     double phi_m_lo, double phi_m_hi, double& a, double& phi_m) {
+void viscosity_guess(const std::vector<double>& phi, const std::vector<double>& eta_r, double mu_c, double phi_m_lo,
+                     double phi_m_hi, double& a, double& phi_m) {
   std::vector<double> x, z;
   for (std::size_t k = 0; k < phi.size(); ++k) {
     const double excess = eta_r[k] - 1.0 - 2.5 * phi[k];
@@ -193,7 +193,7 @@ void viscosity_guess(const std::vector<double>& phi, const std::vector<double>& 
 FitResult fit_viscosity(FitKind kind, const std::vector<double>& phi, const std::vector<double>& eta_r,
                         const SteadyParams& base, const FitOptions& options) {
   const double phi_max = *std::max_element(phi.begin(), phi.end());
-  double lo = 0.0, hi = 0.0;  // admissible phi_m
+  double lo = 0.0, hi = 0.0;   // admissible phi_m
   if (kind == FitKind::low) {  // phi_j > max data phi, phi_j > base phi_c, phi_j < 1
     lo = std::max(phi_max, base.phi_c) + kStrict;
     hi = 1.0 - kStrict;
@@ -261,8 +261,7 @@ double dst_offset(const SteadyParams& base, double phi, double rate) {
 /// y_k = ln(1/eta_B) = ln sum_i phi_i gap^alpha_i at x_k = ln gap. Sorted by gap, the points are
 /// cut into `terms` runs; a straight line through each run starts one term (the run at the
 /// largest gaps starts the steepest). Several cut positions give several starts.
-std::vector<std::vector<double>> dst_guesses(const std::vector<double>& x, const std::vector<double>& y,
-                                             int terms) {
+std::vector<std::vector<double>> dst_guesses(const std::vector<double>& x, const std::vector<double>& y, int terms) {
   std::vector<std::size_t> order(x.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
   std::sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) { return x[i] > x[j]; });
@@ -297,8 +296,8 @@ std::vector<std::vector<double>> dst_guesses(const std::vector<double>& x, const
   return starts;
 }
 
-FitResult fit_dst(const std::vector<double>& phi, const std::vector<double>& rate, const SteadyParams& base,
-                  int terms, const FitOptions& options) {
+FitResult fit_dst(const std::vector<double>& phi, const std::vector<double>& rate, const SteadyParams& base, int terms,
+                  const FitOptions& options) {
   std::vector<double> ln_gap(phi.size()), offset(phi.size()), ln_inv_eta_B(phi.size());
   for (std::size_t k = 0; k < phi.size(); ++k) {
     ln_gap[k] = std::log(base.phi_j - phi[k]);
@@ -384,10 +383,11 @@ FitKind parse_fit_kind(const std::string& text, const std::string& where) {
   if (text == "low") return FitKind::low;
   if (text == "high") return FitKind::high;
   if (text == "dst") return FitKind::dst;
-  throw InputError(fmt::format("{} = '{}': must be one of low (a_0, phi_j from minimum viscosities, E12), "
-                               "high (a_inf, phi_c from plateau viscosities, E13), dst (eta_B terms from DST "
-                               "rates, E14)",
-                               where, text));
+  throw InputError(
+      fmt::format("{} = '{}': must be one of low (a_0, phi_j from minimum viscosities, E12), "
+                  "high (a_inf, phi_c from plateau viscosities, E13), dst (eta_B terms from DST "
+                  "rates, E14)",
+                  where, text));
 }
 
 int fit_parameter_count(FitKind kind, const SteadyParams& base, const FitOptions& options) {
@@ -408,9 +408,10 @@ void validate_fit_data(FitKind kind, const std::vector<double>& phi, const std::
   }
   const int p = fit_parameter_count(kind, base, options);
   if (static_cast<int>(phi.size()) < p + 1) {
-    throw InputError(fmt::format("{}: {} data points, but the {} fit has {} parameters: need at least {} points "
-                                 "(n >= parameters + 1)",
-                                 w, phi.size(), to_string(kind), p, p + 1));
+    throw InputError(
+        fmt::format("{}: {} data points, but the {} fit has {} parameters: need at least {} points "
+                    "(n >= parameters + 1)",
+                    w, phi.size(), to_string(kind), p, p + 1));
   }
   const double ps = phi_star(base);
   for (std::size_t k = 0; k < phi.size(); ++k) {
@@ -422,21 +423,23 @@ void validate_fit_data(FitKind kind, const std::vector<double>& phi, const std::
       throw InputError(fmt::format("{}: point {}: {} = {}: must be positive", w, k + 1, value_name, v));
     }
     if (kind == FitKind::high && !(f < base.phi_j)) {
-      throw InputError(fmt::format("{}: point {}: phi = {}: plateau data need phi < phi_j = {} of the base set "
-                                   "(E13 holds for phi < phi_c < phi_j)",
-                                   w, k + 1, f, base.phi_j));
+      throw InputError(
+          fmt::format("{}: point {}: phi = {}: plateau data need phi < phi_j = {} of the base set "
+                      "(E13 holds for phi < phi_c < phi_j)",
+                      w, k + 1, f, base.phi_j));
     }
     if (kind == FitKind::dst && !(f >= base.phi_c && f <= ps && f < base.phi_j)) {
-      throw InputError(fmt::format("{}: point {}: phi = {}: E14 applies only for phi_c <= phi <= phi* and "
-                                   "phi < phi_j (base set: phi_c = {}, phi* = {}, phi_j = {}); fit phi_c and "
-                                   "phi_j first (--kind high, --kind low)",
-                                   w, k + 1, f, base.phi_c, ps, base.phi_j));
+      throw InputError(
+          fmt::format("{}: point {}: phi = {}: E14 applies only for phi_c <= phi <= phi* and "
+                      "phi < phi_j (base set: phi_c = {}, phi* = {}, phi_j = {}); fit phi_c and "
+                      "phi_j first (--kind high, --kind low)",
+                      w, k + 1, f, base.phi_c, ps, base.phi_j));
     }
   }
 }
 
-FitResult fit(FitKind kind, const std::vector<double>& phi, const std::vector<double>& values,
-              const SteadyParams& base, const FitOptions& options) {
+FitResult fit(FitKind kind, const std::vector<double>& phi, const std::vector<double>& values, const SteadyParams& base,
+              const FitOptions& options) {
   validate_fit_data(kind, phi, values, base, options);
   FitResult r = kind == FitKind::dst ? fit_dst(phi, values, base, fit_parameter_count(kind, base, options) / 2, options)
                                      : fit_viscosity(kind, phi, values, base, options);

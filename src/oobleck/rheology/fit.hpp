@@ -41,16 +41,16 @@ struct FittedParameter {
 
 struct FitResult {
   FitKind kind = FitKind::low;
-  SteadyParams params;                       ///< base set with the fitted values replaced
-  std::vector<FittedParameter> parameters;   ///< fitted values with standard errors
-  int n = 0;                                 ///< number of data points
-  int p = 0;                                 ///< number of fitted parameters
-  double rms = 0.0;           ///< sqrt(mean r_k^2) of the log residuals [-] (0.02 ~ 2 % scatter)
-  double cost = 0.0;          ///< Ceres cost 0.5 sum r_k^2 at the solution
-  double residual_variance = 0.0;  ///< s^2 = 2 cost/(n - p)
-  int iterations = 0;         ///< trust-region iterations of the accepted solve
-  bool covariance_ok = false; ///< false: Jacobian rank-deficient, std errors are NaN
-  std::string solver_report;  ///< Ceres' one-line summary
+  SteadyParams params;                      ///< base set with the fitted values replaced
+  std::vector<FittedParameter> parameters;  ///< fitted values with standard errors
+  int n = 0;                                ///< number of data points
+  int p = 0;                                ///< number of fitted parameters
+  double rms = 0.0;                         ///< sqrt(mean r_k^2) of the log residuals [-] (0.02 ~ 2 % scatter)
+  double cost = 0.0;                        ///< Ceres cost 0.5 sum r_k^2 at the solution
+  double residual_variance = 0.0;           ///< s^2 = 2 cost/(n - p)
+  int iterations = 0;                       ///< trust-region iterations of the accepted solve
+  bool covariance_ok = false;               ///< false: Jacobian rank-deficient, std errors are NaN
+  std::string solver_report;                ///< Ceres' one-line summary
 };
 
 /// Checks the data (sizes, n >= p + 1, 0 < phi < 1, values > 0 and finite, kind-specific
@@ -65,8 +65,8 @@ int fit_parameter_count(FitKind kind, const SteadyParams& base, const FitOptions
 /// Fit `kind` to (phi, values) starting from an initial guess derived from the data alone.
 /// Throws InputError for bad data (see validate_fit_data) and NumericalError when the solver
 /// does not converge.
-FitResult fit(FitKind kind, const std::vector<double>& phi, const std::vector<double>& values,
-              const SteadyParams& base, const FitOptions& options = {});
+FitResult fit(FitKind kind, const std::vector<double>& phi, const std::vector<double>& values, const SteadyParams& base,
+              const FitOptions& options = {});
 
 /// The fitted model at phi (relative viscosity for low/high, DST rate [1/s] for dst), evaluated
 /// with the library's closed forms E12/E13/E14; NaN where the asymptote does not exist.

@@ -17,9 +17,10 @@ namespace oobleck::rheology {
 
 void validate_phi(const SteadyParams& p, double phi, const std::string& where) {
   if (!(std::isfinite(phi) && phi > 0.0 && phi < p.phi_j)) {
-    throw InputError(fmt::format("{} = {}: must lie in (0, phi_j) with phi_j = {}; at phi >= phi_j the "
-                                 "suspension is jammed and has no steady flow",
-                                 where, phi, p.phi_j));
+    throw InputError(
+        fmt::format("{} = {}: must lie in (0, phi_j) with phi_j = {}; at phi >= phi_j the "
+                    "suspension is jammed and has no steady flow",
+                    where, phi, p.phi_j));
   }
 }
 
@@ -29,11 +30,11 @@ SteadyPoint steady_point(const SteadyParams& p, double phi, double f, double gap
   const double fm = f_m(p, phi);
   const double fj = f_jam(p, phi);
   const double fu = std::min(fm, fj);
-  const double fm_minus_f = (fm - fu) + gap;                 // f_m - f
-  const double phim_minus_phi = phi_m_gap(p, (fj - fu) + gap);  // phi_m(f) - phi (E1)
-  const double a = a_of_f(p, f);                             // E2
+  const double fm_minus_f = (fm - fu) + gap;                            // f_m - f
+  const double phim_minus_phi = phi_m_gap(p, (fj - fu) + gap);          // phi_m(f) - phi (E1)
+  const double a = a_of_f(p, f);                                        // E2
   const double c = granular_viscosity(phi, a, phim_minus_phi, p.mu_c);  // tau_bar/(eta_0 gamma_dot)
-  const double inv_eta_B = inverse_eta_B(p, phi);            // E8
+  const double inv_eta_B = inverse_eta_B(p, phi);                       // E8
 
   // E11 (xi_dot_eps = 0): gamma_dot = tau*/(c eta_0) [(1 + c eta_0/eta_B) f/(f_m - f)]^{2/3}
   const double B = (1.0 + c * p.eta_0 * inv_eta_B) * f;
@@ -62,10 +63,10 @@ SteadyPoint steady_point(const SteadyParams& p, double phi, double f, double gap
   s.phi = phi;
   s.f = f;
   s.shear_rate = gamma_dot;
-  s.eta_r = 1.0 + 2.5 * phi + c;  // E3
-  s.granular_shear_stress = c * p.eta_0 * gamma_dot;                                  // E5
-  s.granular_pressure = eta_n(phi, a, phim_minus_phi) * p.eta_0 * gamma_dot;          // E4
-  s.shear_stress = s.eta_r * p.eta_0 * gamma_dot;                                     // E3
+  s.eta_r = 1.0 + 2.5 * phi + c;                                              // E3
+  s.granular_shear_stress = c * p.eta_0 * gamma_dot;                          // E5
+  s.granular_pressure = eta_n(phi, a, phim_minus_phi) * p.eta_0 * gamma_dot;  // E4
+  s.shear_stress = s.eta_r * p.eta_0 * gamma_dot;                             // E3
   s.viscosity = s.eta_r * p.eta_0;
   return s;
 }
@@ -80,8 +81,8 @@ std::vector<SteadyPoint> flow_curve(const SteadyParams& p, double phi, int point
   curve.reserve(static_cast<std::size_t>(points));
   for (int k = 0; k < points; ++k) {
     const double x = -x_max + 2.0 * x_max * k / (points - 1);
-    const double s = 1.0 / (1.0 + std::exp(-x));      // f/f_u
-    const double s_gap = 1.0 / (1.0 + std::exp(x));   // 1 - f/f_u, without cancellation
+    const double s = 1.0 / (1.0 + std::exp(-x));     // f/f_u
+    const double s_gap = 1.0 / (1.0 + std::exp(x));  // 1 - f/f_u, without cancellation
     curve.push_back(steady_point(p, phi, fu * s, fu * s_gap));
   }
   return curve;
@@ -105,8 +106,10 @@ std::optional<double> shear_rate_dst(const SteadyParams& p, double phi, std::str
     return no(fmt::format("phi = {} < phi_c = {}: continuous shear thickening (CST), no DST", phi, p.phi_c));
   }
   if (phi > ps) {
-    return no(fmt::format("phi = {} > phi* = {} (Delta = {}): f_m is capped, the flow curve has no DST "
-                          "asymptote (shear jamming)", phi, ps, p.Delta));
+    return no(
+        fmt::format("phi = {} > phi* = {} (Delta = {}): f_m is capped, the flow curve has no DST "
+                    "asymptote (shear jamming)",
+                    phi, ps, p.Delta));
   }
   const double inv_eta_B = inverse_eta_B(p, phi);
   if (!(inv_eta_B > 0.0)) {

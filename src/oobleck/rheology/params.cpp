@@ -13,9 +13,8 @@
 namespace oobleck::rheology {
 
 const std::vector<std::string>& preset_names() {
-  static const std::vector<std::string> names = {"singh2018a", "singh2018b", "dhaene1993",
-                                                 "frith1996",  "guy2015a",   "guy2015b",
-                                                 "fall2015",   "hermes2016"};
+  static const std::vector<std::string> names = {"singh2018a", "singh2018b", "dhaene1993", "frith1996",
+                                                 "guy2015a",   "guy2015b",   "fall2015",   "hermes2016"};
   return names;
 }
 
@@ -93,8 +92,7 @@ void validate(const Preset& p, const std::string& where) {
         fmt::format("must be smaller than steady.phi_j = {} (phi_c < phi_j)", s.phi_j));
   check(s.a_0 > 0.0 && std::isfinite(s.a_0), where, "steady.a_0", s.a_0, "must be positive");
   check(s.a_inf > 0.0 && std::isfinite(s.a_inf), where, "steady.a_inf", s.a_inf, "must be positive");
-  check(s.tau_star > 0.0 && std::isfinite(s.tau_star), where, "steady.tau_star", s.tau_star,
-        "must be positive [Pa]");
+  check(s.tau_star > 0.0 && std::isfinite(s.tau_star), where, "steady.tau_star", s.tau_star, "must be positive [Pa]");
   check(s.eta_0 > 0.0 && std::isfinite(s.eta_0), where, "steady.eta_0", s.eta_0, "must be positive [Pa s]");
   check(s.mu_c > 0.0 && std::isfinite(s.mu_c), where, "steady.mu_c", s.mu_c, "must be positive");
   check(s.Delta >= 0.0 && s.Delta <= 1.0, where, "steady.Delta", s.Delta, "must lie in [0, 1]");
@@ -103,10 +101,10 @@ void validate(const Preset& p, const std::string& where) {
   for (std::size_t i = 0; i < s.eta_B_terms.size(); ++i) {
     const auto key_phi = fmt::format("steady.eta_B[{}].phi_i", i);
     const auto key_alpha = fmt::format("steady.eta_B[{}].alpha", i);
-    check(s.eta_B_terms[i].phi_i >= 0.0 && std::isfinite(s.eta_B_terms[i].phi_i), where,
-          key_phi.c_str(), s.eta_B_terms[i].phi_i, "must be >= 0 [1/(Pa s)]");
-    check(s.eta_B_terms[i].alpha >= 0.0 && std::isfinite(s.eta_B_terms[i].alpha), where,
-          key_alpha.c_str(), s.eta_B_terms[i].alpha, "must be >= 0");
+    check(s.eta_B_terms[i].phi_i >= 0.0 && std::isfinite(s.eta_B_terms[i].phi_i), where, key_phi.c_str(),
+          s.eta_B_terms[i].phi_i, "must be >= 0 [1/(Pa s)]");
+    check(s.eta_B_terms[i].alpha >= 0.0 && std::isfinite(s.eta_B_terms[i].alpha), where, key_alpha.c_str(),
+          s.eta_B_terms[i].alpha, "must be >= 0");
   }
   const GranularParams& g = p.granular;
   check(g.d > 0.0 && std::isfinite(g.d), where, "granular.d", g.d, "must be positive [m]");
@@ -126,8 +124,8 @@ Preset load_preset(const std::string& name) {
   const std::string path = preset_dir() + "/" + name + ".toml";
   if (!std::filesystem::exists(path)) {
     const std::string hint = closest_match(name, names);
-    throw InputError(fmt::format("unknown preset '{}'{}; known presets: {} (or pass --params FILE.toml)",
-                                 name, hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint),
+    throw InputError(fmt::format("unknown preset '{}'{}; known presets: {} (or pass --params FILE.toml)", name,
+                                 hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint),
                                  fmt::join(names, ", ")));
   }
   return read(path);
@@ -151,9 +149,10 @@ std::string to_toml(const Preset& p) {
   out += fmt::format("Delta = {:.17g}       # [-] compliance parameter of f_m\n", s.Delta);
   out += fmt::format("xi_dot_eps = {:.17g}  # [1/s] Brownian structure decay rate\n", s.xi_dot_eps);
   for (const auto& t : s.eta_B_terms) {
-    out += fmt::format("\n[[steady.eta_B]]      # eta_B = (sum phi_i (phi_j - phi)^alpha)^-1\n"
-                       "phi_i = {:.17g}       # [1/(Pa s)]\nalpha = {:.17g}       # [-]\n",
-                       t.phi_i, t.alpha);
+    out += fmt::format(
+        "\n[[steady.eta_B]]      # eta_B = (sum phi_i (phi_j - phi)^alpha)^-1\n"
+        "phi_i = {:.17g}       # [1/(Pa s)]\nalpha = {:.17g}       # [-]\n",
+        t.phi_i, t.alpha);
   }
   out += "\n[granular]\n";
   out += fmt::format("d = {:.17g}           # [m] grain diameter\n", g.d);

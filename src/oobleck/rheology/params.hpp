@@ -15,15 +15,15 @@ struct EtaBTerm {
 
 /// Steady-rheology parameters (paper Tables 1–3; model.md §2).
 struct SteadyParams {
-  double phi_c = 0.0;       ///< [-] frictional jamming fraction (phi_c < phi_j)
-  double phi_j = 0.0;       ///< [-] frictionless jamming fraction
-  double a_0 = 0.0;         ///< [-] dilation parameter at f = 0
-  double a_inf = 0.0;       ///< [-] dilation parameter at f = 1
-  double tau_star = 0.0;    ///< [Pa] repulsive stress scale
-  double eta_0 = 0.0;       ///< [Pa s] fluid viscosity
-  double mu_c = 0.0;        ///< [-] contact friction (= mu_1)
-  double Delta = 0.0;       ///< [-] compliance parameter of f_m (E9), in [0, 1]
-  double xi_dot_eps = 0.0;  ///< [1/s] Brownian/electrostatic structure decay rate
+  double phi_c = 0.0;                 ///< [-] frictional jamming fraction (phi_c < phi_j)
+  double phi_j = 0.0;                 ///< [-] frictionless jamming fraction
+  double a_0 = 0.0;                   ///< [-] dilation parameter at f = 0
+  double a_inf = 0.0;                 ///< [-] dilation parameter at f = 1
+  double tau_star = 0.0;              ///< [Pa] repulsive stress scale
+  double eta_0 = 0.0;                 ///< [Pa s] fluid viscosity
+  double mu_c = 0.0;                  ///< [-] contact friction (= mu_1)
+  double Delta = 0.0;                 ///< [-] compliance parameter of f_m (E9), in [0, 1]
+  double xi_dot_eps = 0.0;            ///< [1/s] Brownian/electrostatic structure decay rate
   std::vector<EtaBTerm> eta_B_terms;  ///< E8; empty means eta_B = infinity
 };
 
@@ -43,10 +43,10 @@ struct GranularParams {
 
 /// A complete parameter set: what a preset file holds.
 struct Preset {
-  std::string name;         ///< e.g. "hermes2016"
-  std::string source;       ///< literature source (free text)
-  std::string units = "SI"; ///< "SI" or "normalized" (Singh: stresses in eta_0 gamma_dot_0)
-  std::string file;         ///< file it was read from ("" when built in code)
+  std::string name;          ///< e.g. "hermes2016"
+  std::string source;        ///< literature source (free text)
+  std::string units = "SI";  ///< "SI" or "normalized" (Singh: stresses in eta_0 gamma_dot_0)
+  std::string file;          ///< file it was read from ("" when built in code)
   SteadyParams steady;
   GranularParams granular;
 };

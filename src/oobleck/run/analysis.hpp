@@ -27,9 +27,9 @@ namespace oobleck::run {
 /// Nodal fields of one snapshot (run/snapshots.hpp), 2D grids: mass-weighted bilinear averages.
 struct SnapshotFields {
   double time_s = 0.0;
-  analysis::GridField2D u_x, u_y;                            ///< mixture velocity [m/s]
-  analysis::GridField2D displacement_x, displacement_y;      ///< grains since t = 0 [m]
-  analysis::GridField2D f, p_grains;                         ///< structure, granular pressure [Pa]
+  analysis::GridField2D u_x, u_y;                        ///< mixture velocity [m/s]
+  analysis::GridField2D displacement_x, displacement_y;  ///< grains since t = 0 [m]
+  analysis::GridField2D f, p_grains;                     ///< structure, granular pressure [Pa]
 };
 
 template <class G>
@@ -79,8 +79,8 @@ void SceneAnalysis<G>::save(io::CheckpointWriter& cp) const {
 template <class G>
 std::unique_ptr<SceneAnalysis<G>> make_analysis(const scene::SceneConfig& config, const scene::BuiltScene<G>& scene);
 
-extern template std::unique_ptr<SceneAnalysis<mpm::PlaneStrain>> make_analysis(const scene::SceneConfig&,
-                                                                               const scene::BuiltScene<mpm::PlaneStrain>&);
+extern template std::unique_ptr<SceneAnalysis<mpm::PlaneStrain>> make_analysis(
+    const scene::SceneConfig&, const scene::BuiltScene<mpm::PlaneStrain>&);
 extern template std::unique_ptr<SceneAnalysis<mpm::Axisymmetric>> make_analysis(
     const scene::SceneConfig&, const scene::BuiltScene<mpm::Axisymmetric>&);
 extern template std::unique_ptr<SceneAnalysis<mpm::ThreeD>> make_analysis(const scene::SceneConfig&,

@@ -216,7 +216,8 @@ nlohmann::json AnnularAnalysis<G>::steady_flow_result(const analysis::AnnularGeo
       // tau_0 -> infinity on a DST asymptote: omega_bob -> gamma_dot_DST ln(r_o/r_0).
       if (dst) limit = std::max(limit, analysis::steady_bob_speed_limit(*dst, geo));
       sf["bob_speed_limit"] = limit;
-      sf["bob_speed_limit_stress"] = limit > c.bob_speed_m_per_s ? nlohmann::json(nullptr) : nlohmann::json(c.bob_stress_Pa);
+      sf["bob_speed_limit_stress"] =
+          limit > c.bob_speed_m_per_s ? nlohmann::json(nullptr) : nlohmann::json(c.bob_stress_Pa);
       sf["steady_flow_possible"] = std::fabs(geo.bob_speed_m_per_s) <= limit;
     } else {  // unbounded flow curve (CST): every bob speed has a steady state
       sf["max_shear_rate"] = nullptr;

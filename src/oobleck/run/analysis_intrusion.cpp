@@ -101,7 +101,8 @@ nlohmann::json IntrusionAnalysis<G>::result() const {
   // The bed bottom is the longitudinal wall. k_l, k_t are defined at constant v_0: an intruder
   // that ramps up to speed is fitted from the first sample whose (centred) time window lies
   // after its ramp.
-  fo.t_begin_s = tb.cfg->ramp_time_s > 0 ? tb.cfg->ramp_time_s + 0.5 * static_cast<double>(window - 1) * sample_dt : 0.0;
+  fo.t_begin_s =
+      tb.cfg->ramp_time_s > 0 ? tb.cfg->ramp_time_s + 0.5 * static_cast<double>(window - 1) * sample_dt : 0.0;
   auto fronts = [&](const std::vector<analysis::IntrusionFrame>& frames, const analysis::FrontCriterion& crit) {
     nlohmann::json j;
     const auto series = analysis::measure_front_series(frames, crit, geo, window);

@@ -23,7 +23,8 @@ class RodAnalysis final : public SceneAnalysis<G> {
   using Base::scene_;
 
  public:
-  RodAnalysis(const scene::SceneConfig& config, const scene::BuiltScene<G>& scene) : Base(config, scene), track_(scene) {}
+  RodAnalysis(const scene::SceneConfig& config, const scene::BuiltScene<G>& scene)
+      : Base(config, scene), track_(scene) {}
 
   void sample() override { track_.sample(); }
 
@@ -80,7 +81,8 @@ nlohmann::json RodAnalysis<G>::result() const {
   }
   std::size_t stencil = 1;
   if (cfg_.analysis.filter_window_s > 0)
-    stencil = std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(cfg_.analysis.filter_window_s / sample_dt)));
+    stencil =
+        std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(cfg_.analysis.filter_window_s / sample_dt)));
   out["rod_position"] = analysis::to_json(zb);
   out["rod_centre"] = analysis::to_json(zc);
   out["rod_velocity"] = analysis::to_json(vz);
@@ -98,8 +100,10 @@ nlohmann::json RodAnalysis<G>::result() const {
   out["difference_stencil_samples"] = stencil;
   const double surface = scene::bed_surface(cfg_);
   out["bed_surface"] = surface;
-  if (auto ti = analysis::impact_time_from_position(zb, surface, -1.0)) out["impact_time"] = *ti;
-  else out["impact_time"] = nullptr;
+  if (auto ti = analysis::impact_time_from_position(zb, surface, -1.0))
+    out["impact_time"] = *ti;
+  else
+    out["impact_time"] = nullptr;
   out["final_depth"] = surface - zb.value.back();
   if (!profile_.is_null()) out["displacement_below_rod"] = profile_;
   out["final_velocity"] = vz.value.back();

@@ -147,8 +147,11 @@ nlohmann::json WheelAnalysis<G>::result() const {
 template <class G>
 nlohmann::json WheelAnalysis<G>::scatter_result() const {
   auto scatter_json = [](const analysis::PressureScatter& r) {
-    return nlohmann::json{{"relative", r.relative}, {"rms_deviation", r.rms_deviation_Pa}, {"rms", r.rms_Pa},
-                          {"points", r.points}, {"cells", r.cells}};
+    return nlohmann::json{{"relative", r.relative},
+                          {"rms_deviation", r.rms_deviation_Pa},
+                          {"rms", r.rms_Pa},
+                          {"points", r.points},
+                          {"cells", r.cells}};
   };
   nlohmann::json series = nlohmann::json::array();
   std::vector<analysis::PressureScatter> later;

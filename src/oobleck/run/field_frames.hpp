@@ -65,13 +65,13 @@ void restore_field_frames(const io::Checkpoint& cp, const std::string& name, con
 
 inline void save_intrusion_frames(io::CheckpointWriter& cp, const std::string& name,
                                   const std::vector<analysis::IntrusionFrame>& frames) {
-  save_field_frames(cp, name, frames, [](const analysis::IntrusionFrame& f) -> const analysis::GridField2D& {
-    return f.field;
-  });
+  save_field_frames(cp, name, frames,
+                    [](const analysis::IntrusionFrame& f) -> const analysis::GridField2D& { return f.field; });
 }
 
 inline void restore_intrusion_frames(const io::Checkpoint& cp, const std::string& name,
-                                     const analysis::GridField2D& shape, std::vector<analysis::IntrusionFrame>& frames) {
+                                     const analysis::GridField2D& shape,
+                                     std::vector<analysis::IntrusionFrame>& frames) {
   const std::vector<double> tips = cp.has(name + "/tip_z") ? cp.doubles(name + "/tip_z") : std::vector<double>{};
   restore_field_frames(cp, name, shape, frames, [&](double t, analysis::GridField2D f, std::size_t k) {
     analysis::IntrusionFrame fr;

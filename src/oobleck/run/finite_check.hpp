@@ -28,9 +28,9 @@ std::optional<NonFinitePoint> first_non_finite(const mpm::Body<G>& body) {
     if (!std::isfinite(sum)) bad = std::min(bad, p);
   }
   if (bad == std::numeric_limits<std::int64_t>::max()) return std::nullopt;
-  const char* what = !body.x_m[bad].allFinite()          ? "position"
-                     : !body.v_m_s[bad].allFinite()       ? "velocity"
-                     : !body.stress_Pa[bad].allFinite()   ? "stress"
+  const char* what = !body.x_m[bad].allFinite()            ? "position"
+                     : !body.v_m_s[bad].allFinite()        ? "velocity"
+                     : !body.stress_Pa[bad].allFinite()    ? "stress"
                      : !std::isfinite(body.volume_m3[bad]) ? "volume"
                                                            : "state (overflow of finite values)";
   return NonFinitePoint{bad, what};

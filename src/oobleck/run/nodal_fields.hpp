@@ -56,8 +56,10 @@ analysis::GridField2D nodal_average(const mpm::Grid<2>& grid, const std::vector<
       for (int dj = 0; dj < 2; ++dj) {
         for (int di = 0; di < 2; ++di) {
           long i = i0 + di, j = j0 + dj;
-          if (grid.periodic[0]) i = ((i % static_cast<long>(out.nx)) + static_cast<long>(out.nx)) % static_cast<long>(out.nx);
-          if (grid.periodic[1]) j = ((j % static_cast<long>(out.ny)) + static_cast<long>(out.ny)) % static_cast<long>(out.ny);
+          if (grid.periodic[0])
+            i = ((i % static_cast<long>(out.nx)) + static_cast<long>(out.nx)) % static_cast<long>(out.nx);
+          if (grid.periodic[1])
+            j = ((j % static_cast<long>(out.ny)) + static_cast<long>(out.ny)) % static_cast<long>(out.ny);
           if (i < 0 || j < 0 || i >= static_cast<long>(out.nx) || j >= static_cast<long>(out.ny)) continue;
           const double w = (di ? tx : 1.0 - tx) * (dj ? ty : 1.0 - ty) * m;
           const auto k = static_cast<std::size_t>(j) * out.nx + static_cast<std::size_t>(i);

@@ -34,7 +34,7 @@ void add_to_cloud(io::PointCloud& cloud, const mpm::PersistentField& f, std::siz
   const std::string& name = f.shown_as();
   switch (f.frame) {
     case mpm::FrameForm::vector: cloud.vector(name, f.width, *d); return;
-    case mpm::FrameForm::sym_tensor: {  // 3×3, column-major: (i, j) at i + 3 j
+    case mpm::FrameForm::sym_tensor: {        // 3×3, column-major: (i, j) at i + 3 j
       const int idx[6] = {0, 3, 6, 4, 7, 8};  // xx xy xz yy yz zz
       std::array<std::vector<double>*, 6> c{};
       for (int k = 0; k < 6; ++k) {
@@ -170,9 +170,9 @@ std::vector<double> series_row(const scene::BuiltScene<G>& scene) {
   return r;
 }
 
-#define OOBLECK_INSTANTIATE_OUTPUT(G)                                                  \
-  template void write_frame(io::FrameWriter&, const scene::BuiltScene<G>&);            \
-  template std::vector<std::string> series_columns(const scene::BuiltScene<G>&);       \
+#define OOBLECK_INSTANTIATE_OUTPUT(G)                                            \
+  template void write_frame(io::FrameWriter&, const scene::BuiltScene<G>&);      \
+  template std::vector<std::string> series_columns(const scene::BuiltScene<G>&); \
   template std::vector<double> series_row(const scene::BuiltScene<G>&)
 OOBLECK_INSTANTIATE_OUTPUT(mpm::PlaneStrain);
 OOBLECK_INSTANTIATE_OUTPUT(mpm::Axisymmetric);

@@ -187,8 +187,8 @@ nlohmann::json SceneRun<G>::run() {
   for (long s = first + 1; s <= last; ++s) {
     for (const auto& tb : scene_.third)  // prescribed bodies ramping up to speed
       if (tb.cfg->ramp_time_s > 0.0)
-        solver().set_prescribed_velocity(
-            tb.body, scene::prescribed_velocity<G::ncomp>(*tb.cfg, solver().time_s(), scene_.dt_s));
+        solver().set_prescribed_velocity(tb.body,
+                                         scene::prescribed_velocity<G::ncomp>(*tb.cfg, solver().time_s(), scene_.dt_s));
     solver().step();
     check_finite();  // before anything of this step is measured or written
     analysis_->after_step();
@@ -235,8 +235,11 @@ nlohmann::json SceneRun<G>::summary(long steps_run, bool complete, double wall_s
       wall_s > 0 ? static_cast<double>(points) * static_cast<double>(steps_run) / wall_s : 0.0;
   j["threads"] = solver().threads();
   j["library_instruction_set"] = library_instruction_set();  // which CPU variant ran
-  j["timings_seconds"] = {{"p2g", tm.p2g}, {"grid", tm.grid}, {"g2p", tm.g2p},
-                          {"stress", tm.stress}, {"output_and_checks", wall_s - tm.total()}};
+  j["timings_seconds"] = {{"p2g", tm.p2g},
+                          {"grid", tm.grid},
+                          {"g2p", tm.g2p},
+                          {"stress", tm.stress},
+                          {"output_and_checks", wall_s - tm.total()}};
   j["parameters"] = parameters(cfg_);
   j.update(analysis_->result());
   if (!scene_.third.empty()) j["bodies"] = bodies_summary(scene_);

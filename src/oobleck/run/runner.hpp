@@ -11,12 +11,12 @@
 namespace oobleck::run {
 
 struct RunOptions {
-  std::string out_dir;             ///< run folder (created)
-  int threads = 0;                 ///< OpenMP threads (0: default)
-  long checkpoint_every = -1;      ///< steps between checkpoints (-1: the scene's value)
-  bool quiet = false;              ///< no progress output
-  bool restart = false;            ///< continue from out_dir/checkpoint.h5
-  long stop_after_steps = -1;      ///< stop (with a checkpoint) after this many steps in total (tests)
+  std::string out_dir;         ///< run folder (created)
+  int threads = 0;             ///< OpenMP threads (0: default)
+  long checkpoint_every = -1;  ///< steps between checkpoints (-1: the scene's value)
+  bool quiet = false;          ///< no progress output
+  bool restart = false;        ///< continue from out_dir/checkpoint.h5
+  long stop_after_steps = -1;  ///< stop (with a checkpoint) after this many steps in total (tests)
 };
 
 /// Run the scene to its end and return the summary (also written to out_dir/summary.json).

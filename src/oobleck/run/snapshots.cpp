@@ -57,8 +57,10 @@ SnapshotFields Snapshots<G>::fields() const {
       };
       s.displacement_x = displacement(0);
       s.displacement_y = displacement(1);
-      s.f = nodal_average<G>(grid, gs, [&](std::size_t, std::int64_t p) { return law->f[static_cast<std::size_t>(p)]; });
-      s.p_grains = nodal_average<G>(grid, gs, [&](std::size_t, std::int64_t p) { return -gb.stress_Pa[p].trace() / 3.0; });
+      s.f =
+          nodal_average<G>(grid, gs, [&](std::size_t, std::int64_t p) { return law->f[static_cast<std::size_t>(p)]; });
+      s.p_grains =
+          nodal_average<G>(grid, gs, [&](std::size_t, std::int64_t p) { return -gb.stress_Pa[p].trace() / 3.0; });
     } else {
       s.displacement_x = s.u_x;
       std::fill(s.displacement_x.values.begin(), s.displacement_x.values.end(), 0.0);
@@ -94,7 +96,8 @@ SnapshotFields Snapshots<G>::write_next() {
     const std::string name = fmt::format("snapshot_{}.csv", next_);
     io::write_file_atomically(out_dir_ + "/" + name,
                               fmt::format("# t = {:.9g} s (requested {:.9g} s), step {}\n", solver.time_s(),
-                                          cfg_.analysis.snapshot_times_s[next_], solver.steps()) + text,
+                                          cfg_.analysis.snapshot_times_s[next_], solver.steps()) +
+                                  text,
                               "snapshot");
     files_.push_back(name);
     ++next_;

@@ -58,9 +58,9 @@ void restore_solver_state(const io::Checkpoint& cp, const scene::BuiltScene<G>& 
   }
 }
 
-#define OOBLECK_INSTANTIATE_STATE(G)                                                     \
-  template mpm::FieldList solver_fields(const scene::BuiltScene<G>&);                    \
-  template void save_solver_state(io::CheckpointWriter&, const scene::BuiltScene<G>&);   \
+#define OOBLECK_INSTANTIATE_STATE(G)                                                   \
+  template mpm::FieldList solver_fields(const scene::BuiltScene<G>&);                  \
+  template void save_solver_state(io::CheckpointWriter&, const scene::BuiltScene<G>&); \
   template void restore_solver_state(const io::Checkpoint&, const scene::BuiltScene<G>&)
 OOBLECK_INSTANTIATE_STATE(mpm::PlaneStrain);
 OOBLECK_INSTANTIATE_STATE(mpm::Axisymmetric);

@@ -48,8 +48,8 @@ std::unique_ptr<mpm::Solver<G>> make_solver(const SceneConfig& cfg, int threads)
   so.mixture.rho_s_kg_m3 = cfg.material.granular.rho_s;
   so.mixture.rho_f0_kg_m3 = cfg.fluid.rho_f0_kg_m3;
   so.mixture.min_porosity = cfg.coupling.porosity_min;
-  so.mixture.drag.law = cfg.coupling.drag == DragLaw::Beetstra ? material::DragLaw::Beetstra
-                                                               : material::DragLaw::CarmanKozeny;
+  so.mixture.drag.law =
+      cfg.coupling.drag == DragLaw::Beetstra ? material::DragLaw::Beetstra : material::DragLaw::CarmanKozeny;
   so.mixture.drag.d_m = cfg.material.granular.d;
   so.mixture.drag.eta_0_Pa_s = cfg.fluid.eta_0_Pa_s;
   return std::make_unique<mpm::Solver<G>>(grid, so);
@@ -163,8 +163,10 @@ Bed fill_regions(const SceneConfig& cfg, BuiltScene<G>& s) {
   }
   for (int b = 0; b < s.solver->body_count(); ++b) {
     if (s.solver->body(b).size() == 0) {
-      throw InputError(fmt::format("{}: body '{}' got no material points: regions must span at least one "
-                                   "point spacing (cell_size/points_per_cell)", cfg.file, s.solver->body(b).name));
+      throw InputError(
+          fmt::format("{}: body '{}' got no material points: regions must span at least one "
+                      "point spacing (cell_size/points_per_cell)",
+                      cfg.file, s.solver->body(b).name));
     }
   }
   return bed;
@@ -240,8 +242,10 @@ void set_time_step(const SceneConfig& cfg, BuiltScene<G>& s) {
   } else {
     s.dt_s = s.solver->stable_dt(cfg.time.cfl);
     if (!std::isfinite(s.dt_s)) {
-      throw InputError(fmt::format("{}: no stable time step could be derived (no material with a wave speed); "
-                                   "set time.dt", cfg.file));
+      throw InputError(
+          fmt::format("{}: no stable time step could be derived (no material with a wave speed); "
+                      "set time.dt",
+                      cfg.file));
     }
     s.solver->options().dt_s = s.dt_s;
   }

@@ -25,14 +25,14 @@ struct ThirdBody {
 template <class G>
 struct BuiltScene {
   std::unique_ptr<mpm::Solver<G>> solver;
-  int grains = -1;  ///< body index of the mixture's grains (-1: none)
-  int fluid = -1;   ///< body index of the mixture's fluid (-1: none)
+  int grains = -1;                                  ///< body index of the mixture's grains (-1: none)
+  int fluid = -1;                                   ///< body index of the mixture's fluid (-1: none)
   mpm::GranularBodyLaw<G>* granular_law = nullptr;  ///< the grains' law (owned by their body)
   mpm::FluidLaw<G>* fluid_law = nullptr;            ///< the fluid's law (owned by its body)
-  std::vector<ThirdBody> third;  ///< the [[body]] entries, in file order
-  int analysed = -1;             ///< index into `third` of [analysis] body (intrusion, rod, wheel)
-  double dt_s = 0.0;             ///< the time step: time.dt, or the CFL-stable step
-  long total_steps = 0;          ///< round(duration / dt), at least 1
+  std::vector<ThirdBody> third;                     ///< the [[body]] entries, in file order
+  int analysed = -1;                                ///< index into `third` of [analysis] body (intrusion, rod, wheel)
+  double dt_s = 0.0;                                ///< the time step: time.dt, or the CFL-stable step
+  long total_steps = 0;                             ///< round(duration / dt), at least 1
 
   const ThirdBody& analysed_body() const { return third[static_cast<std::size_t>(analysed)]; }
 };

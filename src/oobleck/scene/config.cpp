@@ -62,19 +62,17 @@ std::array<double, 3> read_vec(io::TomlReader& t, std::string_view key, int dim,
 void set_material_overrides(rheology::Preset& p, io::TomlReader& mat) {
   if (auto s = mat.optional_table("steady")) {
     std::map<std::string, double*> keys = {
-        {"phi_c", &p.steady.phi_c},       {"phi_j", &p.steady.phi_j}, {"a_0", &p.steady.a_0},
-        {"a_inf", &p.steady.a_inf},       {"tau_star", &p.steady.tau_star}, {"eta_0", &p.steady.eta_0},
-        {"mu_c", &p.steady.mu_c},         {"Delta", &p.steady.Delta},
-        {"xi_dot_eps", &p.steady.xi_dot_eps}};
+        {"phi_c", &p.steady.phi_c}, {"phi_j", &p.steady.phi_j},       {"a_0", &p.steady.a_0},
+        {"a_inf", &p.steady.a_inf}, {"tau_star", &p.steady.tau_star}, {"eta_0", &p.steady.eta_0},
+        {"mu_c", &p.steady.mu_c},   {"Delta", &p.steady.Delta},       {"xi_dot_eps", &p.steady.xi_dot_eps}};
     for (auto& [k, ptr] : keys) *ptr = s->number_or(k, *ptr);
     s->finish();
   }
   if (auto g = mat.optional_table("granular")) {
-    std::map<std::string, double*> keys = {{"d", &p.granular.d},     {"rho_s", &p.granular.rho_s},
-                                           {"mu_2", &p.granular.mu_2}, {"b", &p.granular.b},
-                                           {"K_3", &p.granular.K_3}, {"K_4", &p.granular.K_4},
-                                           {"G", &p.granular.G},     {"K", &p.granular.K},
-                                           {"K_0", &p.granular.K_0}};
+    std::map<std::string, double*> keys = {
+        {"d", &p.granular.d}, {"rho_s", &p.granular.rho_s}, {"mu_2", &p.granular.mu_2},
+        {"b", &p.granular.b}, {"K_3", &p.granular.K_3},     {"K_4", &p.granular.K_4},
+        {"G", &p.granular.G}, {"K", &p.granular.K},         {"K_0", &p.granular.K_0}};
     for (auto& [k, ptr] : keys) *ptr = g->number_or(k, *ptr);
     g->finish();
   }
@@ -109,9 +107,9 @@ void apply_override(toml::table& root, const std::string& file, const std::strin
       // documented key; a name that is not a section stays an error here, a wrong key inside a
       // created section is caught by the key validation that follows (with a suggestion).
       constexpr std::array<const char*, 10> kOptionalSections{"coupling", "transfer", "analysis", "physics", "output",
-                                                               "time",     "fluid",    "material", "scene",   "aliases"};
-      if (node == nullptr && (i > 0 || std::find(kOptionalSections.begin(), kOptionalSections.end(), part) !=
-                                           kOptionalSections.end())) {
+                                                              "time",     "fluid",    "material", "scene",   "aliases"};
+      if (node == nullptr &&
+          (i > 0 || std::find(kOptionalSections.begin(), kOptionalSections.end(), part) != kOptionalSections.end())) {
         tbl->insert(part, toml::table{});
         node = tbl->get(part);
       }
@@ -127,9 +125,9 @@ void apply_override(toml::table& root, const std::string& file, const std::strin
     if (node == nullptr) {
       std::vector<std::string> alias_names;
       for (const auto& [a, target] : aliases) alias_names.push_back(a);
-      throw InputError(fmt::format("--set {}: {} has no section '{}'{}", spec, file, part,
-                                   alias_names.empty() ? std::string()
-                                                       : fmt::format(" (short names: {})", fmt::join(alias_names, ", "))));
+      throw InputError(fmt::format(
+          "--set {}: {} has no section '{}'{}", spec, file, part,
+          alias_names.empty() ? std::string() : fmt::format(" (short names: {})", fmt::join(alias_names, ", "))));
     }
   }
   if (auto* arr = node->as_array()) {  // an entry of an array: velocity.1, snapshot_times.0
@@ -137,7 +135,8 @@ void apply_override(toml::table& root, const std::string& file, const std::strin
     const std::string& last = parts.back();
     const long idx = std::strtol(last.c_str(), &end, 10);
     if (end == last.c_str() || *end != '\0' || idx < 0 || idx >= static_cast<long>(arr->size())) {
-      throw InputError(fmt::format("--set {}: '{}' has no entry {} in {} (it has {})", spec, key, last, file, arr->size()));
+      throw InputError(
+          fmt::format("--set {}: '{}' has no entry {} in {} (it has {})", spec, key, last, file, arr->size()));
     }
     arr->replace(arr->cbegin() + idx, *holder.get("v"));
     return;
@@ -154,27 +153,26 @@ constexpr std::array<std::pair<const char*, ShapeKind>, 4> kShapes{{{"linear", S
                                                                     {"cubic", ShapeKind::Cubic},
                                                                     {"ugimp", ShapeKind::UGimp}}};
 constexpr std::array<std::pair<const char*, BoundaryType>, 7> kBoundaries{{{"no_slip", BoundaryType::NoSlip},
-                                                                          {"axis", BoundaryType::Axis},
-                                                                          {"slip", BoundaryType::Slip},
-                                                                          {"friction", BoundaryType::Friction},
-                                                                          {"velocity", BoundaryType::Velocity},
-                                                                          {"periodic", BoundaryType::Periodic},
-                                                                          {"open", BoundaryType::Open}}};
+                                                                           {"axis", BoundaryType::Axis},
+                                                                           {"slip", BoundaryType::Slip},
+                                                                           {"friction", BoundaryType::Friction},
+                                                                           {"velocity", BoundaryType::Velocity},
+                                                                           {"periodic", BoundaryType::Periodic},
+                                                                           {"open", BoundaryType::Open}}};
 constexpr std::array<std::pair<const char*, Phase>, 4> kPhases{
     {{"mixture", Phase::Mixture}, {"fluid", Phase::Fluid}, {"grains", Phase::Grains}, {"elastic", Phase::Elastic}}};
 
 constexpr std::array<std::pair<const char*, BodyShape>, 3> kBodyShapes{
     {{"box", BodyShape::Box}, {"disc", BodyShape::Disc}, {"wheel", BodyShape::Wheel}}};
-constexpr std::array<std::pair<const char*, BodyMotionKind>, 3> kMotions{{{"prescribed", BodyMotionKind::Prescribed},
-                                                                         {"free", BodyMotionKind::Free},
-                                                                         {"elastic", BodyMotionKind::Elastic}}};
+constexpr std::array<std::pair<const char*, BodyMotionKind>, 3> kMotions{
+    {{"prescribed", BodyMotionKind::Prescribed}, {"free", BodyMotionKind::Free}, {"elastic", BodyMotionKind::Elastic}}};
 constexpr std::array<std::pair<const char*, AnalysisKind>, 7> kAnalyses{{{"none", AnalysisKind::None},
-                                                                        {"settling", AnalysisKind::Settling},
-                                                                        {"couette", AnalysisKind::Couette},
-                                                                        {"annular", AnalysisKind::Annular},
-                                                                        {"intrusion", AnalysisKind::Intrusion},
-                                                                        {"rod", AnalysisKind::Rod},
-                                                                        {"wheel", AnalysisKind::Wheel}}};
+                                                                         {"settling", AnalysisKind::Settling},
+                                                                         {"couette", AnalysisKind::Couette},
+                                                                         {"annular", AnalysisKind::Annular},
+                                                                         {"intrusion", AnalysisKind::Intrusion},
+                                                                         {"rod", AnalysisKind::Rod},
+                                                                         {"wheel", AnalysisKind::Wheel}}};
 
 // ---- One reader per section of the scene file, in the order load_scene calls them. Each
 // validates its keys as it reads them; the first error throws (file, key and reason), so the
@@ -215,8 +213,7 @@ GridConfig read_grid(io::TomlReader& top) {
     const double n = grid.size_m[a] / grid.cell_size_m;
     g.require(grid.size_m[a] > 0.0, "size", grid.size_m[a], fmt::format("entry {} must be positive [m]", a));
     g.require(std::fabs(n - std::round(n)) < 1e-6 * n, "size", grid.size_m[a],
-              fmt::format("entry {} must be a whole number of cells of size {} m (square cells)", a,
-                          grid.cell_size_m));
+              fmt::format("entry {} must be a whole number of cells of size {} m (square cells)", a, grid.cell_size_m));
     grid.cells[a] = static_cast<int>(std::lround(n));
   }
   if (grid.geometry == Geometry::Axisymmetric) {
@@ -286,8 +283,8 @@ TransferConfig read_transfer(io::TomlReader& top) {
         {{"apic", TransferScheme::Apic}, {"flip", TransferScheme::Flip}}};
     transfer.scheme = parse_enum(*tr, "scheme", TransferScheme::Apic, kSchemes);
     transfer.flip_fraction = tr->number_or("flip_fraction", transfer.flip_fraction);
-    tr->require(transfer.flip_fraction >= 0 && transfer.flip_fraction <= 1, "flip_fraction",
-                transfer.flip_fraction, "must lie in [0, 1]");
+    tr->require(transfer.flip_fraction >= 0 && transfer.flip_fraction <= 1, "flip_fraction", transfer.flip_fraction,
+                "must lie in [0, 1]");
     tr->finish();
   }
   return transfer;
@@ -316,9 +313,9 @@ RegionConfig read_region(io::TomlReader& r, std::size_t index, const GridConfig&
             "must be an integer in [1, 8] (per axis)");
   const int ncomp = grid.geometry == Geometry::PlaneStrain ? 2 : 3;
   reg.velocity_m_s = read_vec(r, "velocity", ncomp, {0, 0, 0}, false, dim);
-  constexpr std::array<std::pair<const char*, InitialState>, 3> kInit{
-      {{"at_rest", InitialState::AtRest}, {"hydrostatic", InitialState::Hydrostatic},
-       {"suspended", InitialState::Suspended}}};
+  constexpr std::array<std::pair<const char*, InitialState>, 3> kInit{{{"at_rest", InitialState::AtRest},
+                                                                       {"hydrostatic", InitialState::Hydrostatic},
+                                                                       {"suspended", InitialState::Suspended}}};
   reg.initial_state = parse_enum(r, "initial_state", InitialState::AtRest, kInit);
   if (reg.phase == Phase::Elastic) {
     reg.elastic.density_kg_m3 = r.number("density");
@@ -430,7 +427,8 @@ void read_body_shape(io::TomlReader& r, const SceneConfig& c, BodyConfig& b) {
     R = b.hub_radius_m + b.paddle_length_m;
   }
   for (int a = 0; a < dim; ++a) {
-    if (!(c.boundary[2 * a].type == BoundaryType::Periodic)) inside_grid("centre", b.centre_m[a] - R, b.centre_m[a] + R, a);
+    if (!(c.boundary[2 * a].type == BoundaryType::Periodic))
+      inside_grid("centre", b.centre_m[a] - R, b.centre_m[a] + R, a);
   }
 }
 
@@ -471,8 +469,9 @@ BodyConfig read_body(io::TomlReader& r, std::size_t index, const SceneConfig& c)
   BodyConfig b;
   b.name = r.string_or("name", fmt::format("body{}", index));
   if (b.name == "grains" || b.name == "fluid" || b.name.empty()) {
-    r.fail("name", fmt::format("= \"{}\": body names must be non-empty and differ from the phases \"grains\", \"fluid\"",
-                               b.name));
+    r.fail(
+        "name",
+        fmt::format("= \"{}\": body names must be non-empty and differ from the phases \"grains\", \"fluid\"", b.name));
   }
   if (!io::is_plain_name(b.name)) r.fail("name", fmt::format("= \"{}\": {}", b.name, io::kPlainNameRule));
   b.shape = parse_enum(r, "shape", BodyShape::Box, kBodyShapes);
@@ -490,7 +489,8 @@ BodyConfig read_body(io::TomlReader& r, std::size_t index, const SceneConfig& c)
   if (r.has("ramp_time") && b.motion != BodyMotionKind::Prescribed)
     r.fail("ramp_time", "only a prescribed body (motion = \"prescribed\") takes a ramp_time");
   b.ramp_time_s = r.number_or("ramp_time", 0.0);
-  r.require(b.ramp_time_s >= 0 && std::isfinite(b.ramp_time_s), "ramp_time", b.ramp_time_s, "must be >= 0 and finite [s]");
+  r.require(b.ramp_time_s >= 0 && std::isfinite(b.ramp_time_s), "ramp_time", b.ramp_time_s,
+            "must be >= 0 and finite [s]");
   b.points_per_cell = static_cast<int>(r.number_or("points_per_cell", 2));
   r.require(b.points_per_cell >= 1 && b.points_per_cell <= 8, "points_per_cell", b.points_per_cell,
             "must be an integer in [1, 8] (per axis)");
@@ -635,7 +635,8 @@ std::map<std::string, std::string> read_aliases(const toml::table& root, const s
   std::map<std::string, std::string> aliases;
   if (const auto* al = root.get_as<toml::table>("aliases")) {
     for (const auto& [k, v] : *al) {
-      if (!v.is_string()) throw InputError(fmt::format("{}: key 'aliases.{}': must be a string key path", path, k.str()));
+      if (!v.is_string())
+        throw InputError(fmt::format("{}: key 'aliases.{}': must be a string key path", path, k.str()));
       aliases[std::string(k.str())] = *v.value<std::string>();
     }
   }

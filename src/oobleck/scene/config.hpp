@@ -27,7 +27,6 @@ const char* to_string(ShapeKind s);
 const char* to_string(BoundaryType b);
 const char* to_string(Phase p);
 
-
 struct GridConfig {
   Geometry geometry = Geometry::PlaneStrain;
   int dim = 2;                              ///< 2 (plane strain, axisymmetric) or 3
@@ -65,11 +64,11 @@ struct RegionConfig {
   std::string name;
   Phase phase = Phase::Mixture;
   std::array<double, 3> min_m{0, 0, 0}, max_m{0, 0, 0};  ///< [m] box corners
-  double phi = 0.0;                                       ///< [-] granular volume fraction (mixture/grains)
-  int points_per_cell = 2;                                ///< per axis and per phase
-  std::array<double, 3> velocity_m_s{0, 0, 0};            ///< [m/s] initial velocity (3 comps; v_theta third in axisymmetric)
+  double phi = 0.0;                                      ///< [-] granular volume fraction (mixture/grains)
+  int points_per_cell = 2;                               ///< per axis and per phase
+  std::array<double, 3> velocity_m_s{0, 0, 0};  ///< [m/s] initial velocity (3 comps; v_theta third in axisymmetric)
   InitialState initial_state = InitialState::AtRest;
-  ElasticConfig elastic;                                  ///< for phase = "elastic"
+  ElasticConfig elastic;  ///< for phase = "elastic"
 };
 
 /// Shape of a third body (model.md §8). Axisymmetric: a box touching r = 0 is a cylinder.
@@ -86,21 +85,23 @@ struct BodyConfig {
   std::array<double, 3> centre_m{0, 0, 0};               ///< [m] centre (disc, wheel)
   double radius_m = 0.0;                                 ///< [m] disc radius
   double hub_radius_m = 0.0;                             ///< [m] wheel hub radius
-  double paddle_length_m = 0.0;                          ///< [m] paddle length beyond the hub (tip radius = hub + paddle)
-  double paddle_width_m = 0.0;                           ///< [m] paddle width
-  int paddles = 4;                                       ///< number of paddles (spokes)
-  double angle_deg = 0.0;                                ///< [deg] angle of the first paddle from +x
+  double paddle_length_m = 0.0;  ///< [m] paddle length beyond the hub (tip radius = hub + paddle)
+  double paddle_width_m = 0.0;   ///< [m] paddle width
+  int paddles = 4;               ///< number of paddles (spokes)
+  double angle_deg = 0.0;        ///< [deg] angle of the first paddle from +x
   BodyMotionKind motion = BodyMotionKind::Prescribed;
-  std::array<double, 3> velocity_m_s{0, 0, 0};           ///< [m/s] prescribed (or initial) velocity (scaled to `speed` when given)
-  double ramp_time_s = 0.0;                              ///< [s] prescribed: speed rises linearly from 0 to |velocity| over this time (0: full speed from t = 0)
-  double density_kg_m3 = 0.0;                            ///< [kg/m^3]
-  std::optional<double> mass_kg;                         ///< [kg] whole-body mass (rigid free bodies; sets the density)
-  double youngs_modulus_Pa = 0.0;                        ///< [Pa] elastic bodies
-  double poisson_ratio = 0.3;                            ///< [-] elastic bodies
-  int points_per_cell = 2;                               ///< per axis
-  double friction = 0.0;                                 ///< [-] Coulomb coefficient between body and grains
-  std::optional<double> motor_omega_rad_s;               ///< [rad/s] motor target ω (elastic, plane strain)
-  double motor_gain = 1.0;                               ///< [-] fraction of the ω error removed per step
+  std::array<double, 3> velocity_m_s{0, 0,
+                                     0};  ///< [m/s] prescribed (or initial) velocity (scaled to `speed` when given)
+  double ramp_time_s =
+      0.0;  ///< [s] prescribed: speed rises linearly from 0 to |velocity| over this time (0: full speed from t = 0)
+  double density_kg_m3 = 0.0;               ///< [kg/m^3]
+  std::optional<double> mass_kg;            ///< [kg] whole-body mass (rigid free bodies; sets the density)
+  double youngs_modulus_Pa = 0.0;           ///< [Pa] elastic bodies
+  double poisson_ratio = 0.3;               ///< [-] elastic bodies
+  int points_per_cell = 2;                  ///< per axis
+  double friction = 0.0;                    ///< [-] Coulomb coefficient between body and grains
+  std::optional<double> motor_omega_rad_s;  ///< [rad/s] motor target ω (elastic, plane strain)
+  double motor_gain = 1.0;                  ///< [-] fraction of the ω error removed per step
 };
 
 struct BoundaryConfig {
@@ -110,9 +111,9 @@ struct BoundaryConfig {
 };
 
 struct TimeConfig {
-  double duration_s = 0.0;           ///< [s] simulated time
-  std::optional<double> dt_s;        ///< [s] user time step (refused above the stable one)
-  double cfl = 0.4;                  ///< fraction of the stable time step used by default
+  double duration_s = 0.0;     ///< [s] simulated time
+  std::optional<double> dt_s;  ///< [s] user time step (refused above the stable one)
+  double cfl = 0.4;            ///< fraction of the stable time step used by default
 };
 
 struct OutputConfig {
@@ -128,9 +129,10 @@ struct AnalysisConfig {
   AnalysisKind kind = AnalysisKind::None;
   double average_from_s = 0.0;   ///< [s] start of the time average (settling)
   double sample_interval_s = 0;  ///< [s] nodal-field sampling interval (annular; 0: duration/200)
-  double sample_z_m = NAN;       ///< [m] height of the surface profile line (annular; default 2 cells below the bed top)
-  std::string body;              ///< body analysed (intrusion, rod, wheel; default: the first [[body]])
-  double filter_window_s = 0.0;  ///< [s] intrusion: moving time average of the sampled fields; rod: finite-difference stencil (0: one sample)
+  double sample_z_m = NAN;  ///< [m] height of the surface profile line (annular; default 2 cells below the bed top)
+  std::string body;         ///< body analysed (intrusion, rod, wheel; default: the first [[body]])
+  double filter_window_s = 0.0;  ///< [s] intrusion: moving time average of the sampled fields; rod: finite-difference
+                                 ///< stencil (0: one sample)
   double front_fraction = 0.5;   ///< [-] velocity front at u_z = fraction v_0 (intrusion)
   double f_threshold = 0.5;      ///< [-] structure front at f = threshold (intrusion)
   /// [s] times of nodal-field snapshots written as snapshot_<k>.csv (2D grids): intrusion u_z
@@ -147,7 +149,7 @@ struct SceneConfig {
   std::string name;
   std::string description;
   GridConfig grid;
-  rheology::Preset material;             ///< suspension parameters (preset + overrides)
+  rheology::Preset material;  ///< suspension parameters (preset + overrides)
   FluidConfig fluid;
   CouplingConfig coupling;
   TransferConfig transfer;

@@ -111,8 +111,10 @@ std::pair<int, int> add_third_body(mpm::Solver<G>& solver, const scene::BodyConf
     vols.push_back(v);
   }
   if (xs.empty()) {
-    throw InputError(fmt::format("{}: body '{}' got no material points: it must span at least one point spacing "
-                                 "(cell_size/points_per_cell = {} m)", file, bc.name, dx));
+    throw InputError(
+        fmt::format("{}: body '{}' got no material points: it must span at least one point spacing "
+                    "(cell_size/points_per_cell = {} m)",
+                    file, bc.name, dx));
   }
   const double density = bc.mass_kg ? *bc.mass_kg / whole_volume : bc.density_kg_m3;
   const mpm::Vec<NC> v0 = prescribed_velocity<NC>(bc, 0.0, 0.0);  // at rest when it ramps up
