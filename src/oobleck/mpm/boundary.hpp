@@ -79,7 +79,6 @@ void for_face_layers(const Grid<D>& grid, int a, bool upper, F&& f) {
   const int N = grid.cells[a], st = grid.stride(a);
   const int layers = Grid<D>::kGhost + 1;
   const int outer = grid.node_count() / (grid.nodes(a) * st);  // product of the slower axes
-#pragma omp parallel for schedule(static) collapse(2) if (outer * layers * st >= kParallelMinNodes)
   for (int o = 0; o < outer; ++o) {
     for (int depth = 0; depth < layers; ++depth) {
       const int i = upper ? N + depth : -depth;  // logical index of the layer

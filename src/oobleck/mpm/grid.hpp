@@ -21,10 +21,11 @@
 
 namespace oobleck::mpm {
 
-/// Node-local grid loops (gravity, velocity update, P2G thread-copy reduction, wall layers, mixture
-/// flux) run in an OpenMP team only above this many nodes: below it the fork/join (a futex wake-up
-/// per region with OMP_WAIT_POLICY=PASSIVE) costs more than the few ns of work per node. Each node
-/// is independent in these loops, so the results do not depend on the choice.
+/// The solver's node passes that have a region of their own (the velocity update of beds without
+/// fluid; the grid pass and the mixture flux at fractions of it, Solver) run on several threads
+/// only above this many nodes: below it the fork/join (a futex wake-up per region with
+/// OMP_WAIT_POLICY=PASSIVE) costs more than the few ns of work per node. Each node is independent
+/// in these passes, so the results do not depend on the choice.
 inline constexpr int kParallelMinNodes = 1 << 15;
 
 template <int D>
