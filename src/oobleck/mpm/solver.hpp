@@ -251,6 +251,7 @@ class Solver {
                                            // for E27;
                                            // 6–7. x, v (FLIP/PIC or APIC), L, V ← V exp(Δt tr L);
                                            // 8. laws (one parallel region; laps g2p and stress)
+      keep_mixture_out_of_free_rigid_bodies();  // 8'. mixture points back out of free rigid bodies
     });
     time_s_ += opt_.dt_s;
     ++steps_;
@@ -522,6 +523,18 @@ class Solver {
         resolve_contact(c, rm, fields_[c.solid], grains, fluid, contact_weight_, mixture_volume, node_measure_,
                         mix_grad, opt_.dt_s);
       }
+    }
+  }
+
+  /// Contact, part 4 (after the points moved): mixture points inside a free rigid body put back
+  /// outside it (contact.hpp, keep_points_out; serial, a test per mixture point).
+  void keep_mixture_out_of_free_rigid_bodies() {
+    for (auto& c : contacts_) {
+      if (rigid_[c.solid].kind != BodyMotion::FreeRigid) continue;
+      if (!c.shape.built) build_rigid_shape(c.shape, *bodies_[c.solid], grid_);
+      c.points_kept_out = 0;
+      for (int b : {grains_, fluid_})
+        if (b >= 0) c.points_kept_out += keep_points_out(c.shape, *bodies_[c.solid], *bodies_[b], grid_);
     }
   }
 
