@@ -374,8 +374,9 @@ TEST(Contact, MotorHoldsMeanAngularVelocityOfFreeElasticWheel) {
 namespace {
 struct Floating {
   double zc, zc_ref, F_over_W, h, zb_min;
+  int fluid_inside;  // fluid points inside the rod's cells at the end
 };
-Floating float_rod() {
+Floating float_rod(double h = 1e-3) {
   // Axisymmetric: a rigid rod (radius R, length L, ρ_b = ρ_f/4) released at rest with its flat end
   // on the free surface of a viscous fluid in a cylinder (radius R_c, depth D; axis, slip wall
   // and floor; the fluid starts hydrostatic). It must come to float with the draft
@@ -384,9 +385,9 @@ Floating float_rod() {
   // mean contact force equals its weight. (Released at the surface it overshoots to ≈ 2d; the
   // freeboard L − 2d keeps the fluid from washing over its top.) Only the fluid's pressure carries
   // the rod (no grains: rod–fluid contact, the fluid slipping along the rod's side).
-  const double h = 1e-3, g = 9.81, rho_f = 1000.0, rho_b = 250.0;
-  const double Rc = 16 * h, D = 16 * h, R = 4 * h, L = 20 * h;
-  Grid<2> grid(Vec<2>(0.0, 0.0), h, {16, 40});
+  const double g = 9.81, rho_f = 1000.0, rho_b = 250.0;
+  const double Rc = 16e-3, D = 16e-3, R = 4e-3, L = 20e-3;
+  Grid<2> grid(Vec<2>(0.0, 0.0), h, {static_cast<int>(std::lround(Rc / h)), static_cast<int>(std::lround(40e-3 / h))});
   SolverOptions<Axisymmetric> opt;
   opt.threads = 1;
   opt.gravity_m_s2 = Vec<3>(0.0, -g, 0.0);
@@ -433,9 +434,14 @@ Floating float_rod() {
       "[ measured ] floating rod: centre %.4f mm vs Archimedes %.4f mm (draft %.2f mm, h = %.1f mm); "
       "F/(M g) = %.4f\n",
       1e3 * zc, 1e3 * zc_ref, 1e3 * d, 1e3 * h, F / (M * g));
-  double zb = 1e9;
-  for (const auto& x : rod.x_m) zb = std::min(zb, x[1]);
-  return {zc, zc_ref, F / (M * g), h, zb};
+  double zb = 1e9, zt = -1e9;
+  for (const auto& x : rod.x_m) {
+    zb = std::min(zb, x[1]);
+    zt = std::max(zt, x[1]);
+  }
+  int inside = 0;  // the rod's cells: r < R, its lowest and highest points ± h/4
+  for (const auto& x : fluid.x_m) inside += x[0] < R && x[1] > zb - h / 4 && x[1] < zt + h / 4;
+  return {zc, zc_ref, F / (M * g), h, zb, inside};
 }
 }  // namespace
 
@@ -448,9 +454,26 @@ TEST(Contact, FreeRodDroppedOntoFluidCarriesItsWeightAndFloats) {
   EXPECT_GT(f.zb_min, 8e-3);
 }
 
+TEST(Contact, FreeRodKeepsTheFluidOutAndFloatsNearArchimedesDraft) {
+  // The fluid stays out of the rod (keep_points_out). Before it, fluid points entered the rod's
+  // bottom cells and stayed (47 at h = 1 mm, 1.2 mm of the rod's cross-section in fluid mass,
+  // carried by the rod): centre 1.49 mm too deep at h = 1 mm (1.74 at 2 mm) and still sinking.
+  // With it: 0.51 / 0.87 mm too deep at h = 1 / 2 mm (0.61 at 0.5 mm: not converging with h; the
+  // rod still sinks ≈ 0.5 mm/s with the mean force equal to its weight and no fluid inside, an
+  // open gap of docs/contact.md). Asserted: no fluid inside; centre within 0.6 mm of Archimedes.
+  const Floating coarse = float_rod(2e-3), fine = float_rod(1e-3);
+  EXPECT_EQ(coarse.fluid_inside, 0);
+  EXPECT_EQ(fine.fluid_inside, 0);
+  const double e2 = coarse.zc - coarse.zc_ref, e1 = fine.zc - fine.zc_ref;
+  std::printf("[ measured ] floating rod: centre - Archimedes %.3f mm (h = 2 mm), %.3f mm (h = 1 mm)\n", 1e3 * e2,
+              1e3 * e1);
+  EXPECT_LT(std::fabs(e1), 0.6e-3);
+  EXPECT_LT(std::fabs(e2), 1.0e-3);
+}
+
 TEST(Contact, DISABLED_FreeRodFloatsAtArchimedesDraft) {
-  // Known gap (docs/contact.md): measured centre 19.8 mm vs 21.3 mm (1.5 cells too deep, still
-  // sinking at ≈ 0.8 mm/s at 0.5 s) at h = 1 mm, draft 5 cells.
+  // Open gap (docs/contact.md): centre 0.51 mm too deep at h = 1 mm (0.87 / 0.61 mm at h = 2 /
+  // 0.5 mm), still sinking ≈ 0.5 mm/s at 0.6 s, with no fluid inside the rod.
   const Floating f = float_rod();
   EXPECT_NEAR(f.zc, f.zc_ref, 0.25 * f.h);
 }

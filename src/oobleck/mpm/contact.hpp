@@ -43,8 +43,10 @@
 // Free functions over arrays; the Solver (solver.hpp) calls them in its grid pass. No allocation
 // inside a step (the nodal mass-gradient buffer is sized once).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 #include <Eigen/LU>
 
@@ -78,6 +80,27 @@ struct RigidMotion {
   void declare_fields(FieldList& list) { list.add_values("rigid_velocity", {velocity_m_s.data(), NC}, "m/s"); }
 };
 
+/// The cells of a translating rigid body's point lattice in its own frame, relative to its first
+/// point: cell c holds a point at x_0 + c dx (dx the lattice spacing, (V_p/measure(x_p, 1))^(1/D)
+/// of its smallest point). A rigid body only translates, so its cells never change; they are
+/// built from the points at the first use (after a restart, from the restored points).
+template <int D>
+struct RigidShape {
+  bool built = false;
+  double dx_m = 0.0;                    ///< lattice spacing
+  std::array<int, D> lo{}, n{};         ///< cell index range: lo .. lo + n − 1 per axis
+  std::vector<unsigned char> occupied;  ///< 1 where a point of the body sits, row-major over n
+  bool occupied_at(const std::array<int, D>& c) const {
+    std::int64_t k = 0;
+    for (int a = 0; a < D; ++a) {
+      const int j = c[a] - lo[a];
+      if (j < 0 || j >= n[a]) return false;
+      k = k * n[a] + j;
+    }
+    return occupied[static_cast<std::size_t>(k)] != 0;
+  }
+};
+
 /// Contact between one solid body and the mixture (grains and/or fluid), model.md §8.
 template <class G>
 struct ContactPair {
@@ -97,7 +120,10 @@ struct ContactPair {
   /// points per step). Sliding block (docs/contact.md): horizontal/normal force 0.317 with the
   /// combined normal vs 0.337 with the solid's alone, for μ = 0.3 at 32 cells/m.
   bool combined_normal = true;
-  int active_nodes = 0;                    ///< nodes where an impulse acted, last step
+  int active_nodes = 0;  ///< nodes where an impulse acted, last step
+  /// Free rigid body: mixture points put back outside it after the last step (keep_points_out).
+  int points_kept_out = 0;
+  RigidShape<G::dim> shape;                ///< free rigid body: its cells (built at the first step)
   std::vector<Vec<G::dim>> mass_gradient;  ///< nodal ∇m_b (sized once)
   std::vector<double> volume_m3;           ///< nodal volume Σ N_ip V_p of the solid (sized once)
   /// Persistent state (mpm/fields.hpp): the impulse sum (the other members are per step).
@@ -489,6 +515,107 @@ Vec<G::ncomp> resolve_rigid_contact(ContactPair<G>& pair, RigidMotion<G>& rm, co
   pair.force_on_grains_N = J_grains / dt_s;
   pair.impulse_sum_N_s += J_body;
   return J_body;
+}
+
+/// Lattice spacing of a point of a lattice body, (V_p/measure(x_p, 1))^(1/D) (plane: √V_p;
+/// axisymmetric, per radian V_p = r dx²: √(V_p/r)); not finite for a point on the axis.
+template <class G>
+double point_spacing(const Body<G>& body, std::int64_t p) {
+  return std::pow(body.volume_m3[p] / G::measure(body.x_m[p], 1.0), 1.0 / G::dim);
+}
+
+/// Build a rigid body's cells (RigidShape) from its points.
+template <class G>
+void build_rigid_shape(RigidShape<G::dim>& shape, const Body<G>& body, const Grid<G::dim>& grid) {
+  constexpr int D = G::dim;
+  shape = RigidShape<D>();
+  shape.built = true;
+  const std::int64_t np = body.size();
+  double dx = INFINITY;
+  for (std::int64_t p = 0; p < np; ++p) {
+    const double s = point_spacing(body, p);
+    if (std::isfinite(s) && s > 0.0) dx = std::min(dx, s);
+  }
+  if (!std::isfinite(dx)) return;  // no points: nothing to keep out
+  shape.dx_m = dx;
+  std::vector<std::array<int, D>> cells(static_cast<std::size_t>(np));
+  std::array<int, D> hi{};
+  for (int a = 0; a < D; ++a) {
+    shape.lo[a] = std::numeric_limits<int>::max();
+    hi[a] = std::numeric_limits<int>::min();
+  }
+  for (std::int64_t p = 0; p < np; ++p) {
+    const Vec<D> d = periodic_difference<D>(grid, body.x_m[p], body.x_m[0]) / dx;
+    for (int a = 0; a < D; ++a) {
+      const int c = static_cast<int>(std::lround(d[a]));
+      cells[static_cast<std::size_t>(p)][a] = c;
+      shape.lo[a] = std::min(shape.lo[a], c);
+      hi[a] = std::max(hi[a], c);
+    }
+  }
+  std::int64_t total = 1;
+  for (int a = 0; a < D; ++a) {
+    shape.n[a] = hi[a] - shape.lo[a] + 1;
+    total *= shape.n[a];
+  }
+  shape.occupied.assign(static_cast<std::size_t>(total), 0);
+  for (const auto& c : cells) {
+    std::int64_t k = 0;
+    for (int a = 0; a < D; ++a) k = k * shape.n[a] + (c[a] - shape.lo[a]);
+    shape.occupied[static_cast<std::size_t>(k)] = 1;
+  }
+}
+
+/// Put the points of a mixture body that lie in a free rigid body's cells back outside it
+/// (docs/contact.md, "Mixture kept out of a free rigid body"): each such point moves along the axis
+/// of its shortest way out to half its own lattice spacing beyond the body's face (not out of the
+/// domain on a non-periodic axis, e.g. through the axis of symmetry). Only the position changes
+/// (velocity, volume and stress are the point's): no momentum is exchanged. Nodal contact
+/// constrains nodal velocities only, so points near the surface, which interpolate from nodes in
+/// and out of contact, and points carried by noise in the mixture, enter a rigid body and stay
+/// there, adding their weight to it. Returns the number of points moved.
+template <class G>
+int keep_points_out(const RigidShape<G::dim>& shape, const Body<G>& rigid, Body<G>& mix, const Grid<G::dim>& grid) {
+  constexpr int D = G::dim;
+  if (shape.occupied.empty() || rigid.size() == 0) return 0;
+  const Vec<D> x0 = rigid.x_m[0];
+  const double dx = shape.dx_m;
+  int moved = 0;
+  const std::int64_t np = mix.size();
+  for (std::int64_t p = 0; p < np; ++p) {
+    const Vec<D> u = periodic_difference<D>(grid, mix.x_m[p], x0) / dx;  // in cells of the body
+    std::array<int, D> c;
+    bool in_box = true;
+    for (int a = 0; a < D && in_box; ++a) {
+      c[a] = static_cast<int>(std::lround(u[a]));
+      in_box = c[a] >= shape.lo[a] && c[a] < shape.lo[a] + shape.n[a];
+    }
+    if (!in_box || !shape.occupied_at(c)) continue;
+    const double gap = 0.5 * std::min(1.0, point_spacing(mix, p) / dx);  // (1 on the axis: not finite)
+    int best_a = -1;
+    double best_du = INFINITY;
+    for (int a = 0; a < D; ++a)
+      for (int dir = -1; dir <= 1; dir += 2) {
+        std::array<int, D> e = c;
+        do {
+          e[a] += dir;
+        } while (shape.occupied_at(e));
+        const double du = (e[a] - 0.5 * dir + gap * dir) - u[a];  // to the free cell's face, + gap
+        const double xa = mix.x_m[p][a] + du * dx;
+        if (!grid.periodic[a] && (xa < grid.origin_m[a] || xa > grid.origin_m[a] + grid.length(a))) continue;
+        if (std::fabs(du) < std::fabs(best_du)) {
+          best_du = du;
+          best_a = a;
+        }
+      }
+    if (best_a < 0) continue;
+    Vec<D> x = mix.x_m[p];
+    x[best_a] += best_du * dx;
+    grid.wrap(x);
+    mix.x_m[p] = x;
+    ++moved;
+  }
+  return moved;
 }
 
 /// Move a rigid body's points rigidly over the step (replaces G2P): x ← x + Δt V, v ← V, C = 0,

@@ -275,9 +275,10 @@ class Solver {
                                                         //    drag (E29); beside it, contact's mass gradients
       resolve_contacts();                               // 4. contact impulses (§8), rigid bodies' velocities
       clock.lap(timings_.grid);
-      update_points<K>(clock);  // 5. walls on nodal velocities, mixture flux q (E27);
-                                // 6. G2P: x, v (APIC or FLIP/PIC), C, L, V ← V exp(Δt tr L);
-                                // 7. laws: stresses (and their state) from L
+      update_points<K>(clock);                  // 5. walls on nodal velocities, mixture flux q (E27);
+                                                // 6. G2P: x, v (APIC or FLIP/PIC), C, L, V ← V exp(Δt tr L);
+                                                // 7. laws: stresses (and their state) from L
+      keep_mixture_out_of_free_rigid_bodies();  // 8. mixture points back out of free rigid bodies (§8)
     });
     time_s_ += opt_.dt_s;
     ++steps_;
@@ -555,6 +556,18 @@ class Solver {
         resolve_contact(c, rm, fields_[c.solid], grains, fluid, contact_weight_, mixture_volume, node_measure_,
                         mix_grad, opt_.dt_s);
       }
+    }
+  }
+
+  /// Contact, part 4 (after the points moved): mixture points inside a free rigid body put back
+  /// outside it (contact.hpp, keep_points_out; serial, a test per mixture point).
+  void keep_mixture_out_of_free_rigid_bodies() {
+    for (auto& c : contacts_) {
+      if (rigid_[c.solid].kind != BodyMotion::FreeRigid) continue;
+      if (!c.shape.built) build_rigid_shape(c.shape, *bodies_[c.solid], grid_);
+      c.points_kept_out = 0;
+      for (int b : {grains_, fluid_})
+        if (b >= 0) c.points_kept_out += keep_points_out(c.shape, *bodies_[c.solid], *bodies_[b], grid_);
     }
   }
 
