@@ -15,6 +15,8 @@
 
 using namespace oobleck;
 using material::GranularRegime;
+using test::log_uniform;
+using test::random_tensor;
 
 namespace {
 
@@ -37,19 +39,6 @@ struct Checker {
     return P.granular.K_3 * (phi - phim / (1.0 + a * Im));  // E18
   }
 };
-
-Eigen::Matrix3d random_tensor(std::mt19937_64& rng, double mag) {
-  std::normal_distribution<double> n(0.0, 1.0);
-  Eigen::Matrix3d m;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) m(i, j) = n(rng);
-  return mag * m / m.norm();
-}
-
-double log_uniform(std::mt19937_64& rng, double lo, double hi) {
-  std::uniform_real_distribution<double> u(std::log(lo), std::log(hi));
-  return std::exp(u(rng));
-}
 
 void sweep(const std::string& preset_name, int n, std::uint64_t seed, double K_0 = 1.0) {
   rheology::Preset P = test::preset(preset_name);

@@ -3,8 +3,11 @@
 // (rheology::steady_point, model.md E11) at a given shear rate or structure.
 #include <cmath>
 #include <limits>
+#include <random>
 #include <string>
 #include <vector>
+
+#include <Eigen/Core>
 
 #include "oobleck/rheology/flow_curve.hpp"
 #include "oobleck/rheology/params.hpp"
@@ -49,5 +52,20 @@ inline double steady_f_at_rate(const rheology::SteadyParams& s, double phi, doub
 }
 
 inline double rel(double a, double b) { return std::fabs(a - b) / std::fabs(b); }
+
+/// A random 3x3 tensor of Frobenius norm `mag` (normal entries, rescaled).
+inline Eigen::Matrix3d random_tensor(std::mt19937_64& rng, double mag) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  Eigen::Matrix3d m;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) m(i, j) = n(rng);
+  return mag * m / m.norm();
+}
+
+/// A value uniform in log between lo and hi.
+inline double log_uniform(std::mt19937_64& rng, double lo, double hi) {
+  std::uniform_real_distribution<double> u(std::log(lo), std::log(hi));
+  return std::exp(u(rng));
+}
 
 }  // namespace oobleck::test
