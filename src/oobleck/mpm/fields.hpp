@@ -8,9 +8,14 @@
 //   Body<G>::declare_fields          the point arrays of every body (group "body<b>")
 //   StressLaw<G>::declare_fields     a law's per-point state (GranularBodyLaw: group "granular",
 //                                    FluidLaw: "fluid") and what it adds to its body's frames
-//   run/solver_state.cpp             the [[body]] entries' rigid velocity and contact impulse sum
-//                                    (group "third<k>")
-// A checkpoint dataset is "GROUP/NAME"; a frame field is NAME (or frame_name) of its body.
+//   RigidMotion / ContactPair        a [[body]] entry's rigid velocity and contact impulse sum
+//   (via run/solver_state.cpp)       (group "third<k>")
+//   Solver<G>::declare_grid_fields   nodal arrays the frames show on the grid (group "grid")
+//   run::SceneAnalysis::declare_fields, run::Snapshots::declare_fields
+//                                    a scene measurement's samples (group "analysis") and its
+//                                    counters (checkpoint attributes)
+// A checkpoint dataset is "GROUP/NAME", an attribute is NAME; a frame field is NAME (or
+// frame_name) of its body, or of the grid.
 #include <cstddef>
 #include <cstdint>
 #include <algorithm>
@@ -26,19 +31,30 @@
 namespace oobleck::mpm {
 
 /// How a field appears in the frames (io/frames.hpp): not at all, as the body's positions, as a
-/// scalar, a vector (width 2 or 3), or a symmetric tensor (width 9, a 3×3 matrix in Eigen's
-/// column-major order; the frame shows xx xy xz yy yz zz).
-enum class FrameForm { none, position, scalar, vector, sym_tensor };
+/// scalar, a vector (width 2 or 3), a symmetric tensor (width 9, a 3×3 matrix in Eigen's
+/// column-major order; the frame shows xx xy xz yy yz zz), or a scalar on the grid's physical
+/// nodes (the array in the grid's storage order, run/run_output.cpp maps it).
+enum class FrameForm { none, position, scalar, vector, sym_tensor, node_scalar };
+
+/// A series that grows during a run (a scene analysis's samples), checkpointed flat: `pack`
+/// gives its values, `unpack` replaces the series with a checkpoint's. Written when not empty,
+/// read when the checkpoint has it (a run that had not sampled it yet).
+struct GrowingSeries {
+  std::function<std::vector<double>()> pack;
+  std::function<void(const std::vector<double>&)> unpack;
+};
 
 /// One named array, `width` values per item, viewed in place (no copy).
 struct PersistentField {
-  std::string group;  ///< checkpoint group: "body0", "granular", "fluid", "third0"
-  std::string name;   ///< the dataset under the group ("x", "ln_J"); also the frame name
+  std::string group;  ///< checkpoint group: "body0", "granular", "fluid", "third0", "analysis"
+  std::string name;   ///< the dataset under the group ("x", "ln_J"), or the attribute's name;
+                      ///< also the frame name
   int width = 1;      ///< values per item (the dataset is stored flat: items × width)
   const char* unit = "1";
-  /// The values, read for checkpoints and frames and written on restore. Empty (monostate) for a
-  /// field the frames derive (`derive`).
-  std::variant<std::monostate, std::span<double>, std::span<std::uint8_t>> data;
+  /// The values, read for checkpoints and frames and written on restore: a fixed-size array
+  /// (span), a growing series, or one number stored as a checkpoint attribute (double* or
+  /// std::int64_t*). Empty (monostate) for a field the frames derive (`derive`).
+  std::variant<std::monostate, std::span<double>, std::span<std::uint8_t>, GrowingSeries, double*, std::int64_t*> data;
   bool in_checkpoint = true;
   FrameForm frame = FrameForm::none;
   std::string frame_name;    ///< the frame's name when it differs from `name`
@@ -50,7 +66,11 @@ struct PersistentField {
   std::string legacy_name;
   double (*from_legacy)(double) = nullptr;
 
-  std::string dataset() const { return group + "/" + name; }
+  bool is_attribute() const {
+    return std::holds_alternative<double*>(data) || std::holds_alternative<std::int64_t*>(data);
+  }
+  /// The checkpoint's name: "GROUP/NAME" for a dataset, NAME for an attribute.
+  std::string dataset() const { return is_attribute() ? name : group + "/" + name; }
   const std::string& shown_as() const { return frame_name.empty() ? name : frame_name; }
 };
 
@@ -109,6 +129,34 @@ class FieldList {
   PersistentField& add_values(std::string name, std::span<double> values, const char* unit) {
     const int width = static_cast<int>(values.size());
     return push({group_, std::move(name), width, unit, values, true, FrameForm::none, {}, 1 << 20, {}, {}, nullptr});
+  }
+  /// A series that grows during the run (see GrowingSeries).
+  PersistentField& add_series(std::string name, const char* unit, std::function<std::vector<double>()> pack,
+                              std::function<void(const std::vector<double>&)> unpack) {
+    return push({group_,
+                 std::move(name),
+                 1,
+                 unit,
+                 GrowingSeries{std::move(pack), std::move(unpack)},
+                 true,
+                 FrameForm::none,
+                 {},
+                 1 << 20,
+                 {},
+                 {},
+                 nullptr});
+  }
+  /// One number, stored as a checkpoint attribute.
+  PersistentField& add_attribute(std::string name, double& value, const char* unit) {
+    return push({group_, std::move(name), 1, unit, &value, true, FrameForm::none, {}, 1 << 20, {}, {}, nullptr});
+  }
+  PersistentField& add_attribute(std::string name, std::int64_t& value, const char* unit) {
+    return push({group_, std::move(name), 1, unit, &value, true, FrameForm::none, {}, 1 << 20, {}, {}, nullptr});
+  }
+  /// A nodal array (grid storage order) the frames show on the physical nodes (not in
+  /// checkpoints: the step recomputes it).
+  PersistentField& add_nodal(std::string name, std::span<double> nodes, const char* unit) {
+    return push({group_, std::move(name), 1, unit, nodes, false, FrameForm::node_scalar, {}, 1 << 20, {}, {}, nullptr});
   }
   /// A scalar the frames compute from other fields (not in checkpoints).
   PersistentField& derived(std::string name, const char* unit, std::function<void(std::span<double>)> fill) {

@@ -186,8 +186,6 @@ class Solver {
     return static_cast<int>(contacts_.size()) - 1;
   }
   const ContactPair<G>& contact(int pair) const { return contacts_[pair]; }
-  /// Restore a pair's accumulated impulse (checkpoint restart).
-  void set_contact_impulse_sum(int pair, const Vec<NC>& J) { contacts_[pair].impulse_sum_N_s = J; }
   /// Declare pair `pair`'s persistent fields (mpm/fields.hpp; restored in place).
   void declare_contact_fields(int pair, FieldList& list) { contacts_[pair].declare_fields(list); }
   int contact_count() const { return static_cast<int>(contacts_.size()); }
@@ -228,6 +226,11 @@ class Solver {
   double time_s() const { return time_s_; }
   /// Nodal porosity of the last step (mixture only; empty otherwise).
   const std::vector<double>& nodal_porosity() const { return porosity_; }
+  /// Declare the nodal arrays the frames show on the grid (mpm/fields.hpp): the nodal porosity
+  /// n of the last step (E28), when there is a mixture.
+  void declare_grid_fields(FieldList& list) {
+    if (!porosity_.empty()) list.add_nodal("porosity", porosity_, "1");
+  }
   std::int64_t steps() const { return steps_; }
   /// Restore the clock from a checkpoint (restart).
   void set_clock(double time_s, std::int64_t steps) {

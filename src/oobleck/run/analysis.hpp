@@ -7,7 +7,9 @@
 //                      step (fields and body tracks: annular, intrusion, rod, wheel)
 //   at_frame()         after each frame is written (the wheel's pressure scatter)
 //   at_snapshot(s)     after each nodal-field snapshot (the rod's depth profile)
-//   save / restore     the sampled state, so that a restart reports what an uninterrupted run does
+//   declare_fields     the sampled state as persistent fields (mpm/fields.hpp, group
+//                      "analysis"), which the checkpoints write and restore, so that a restart
+//                      reports what an uninterrupted run does
 //   result()           the keys it adds to summary.json
 //
 // A new measurement is one new file analysis_<kind>.cpp with a make_<kind>_analysis function,
@@ -18,7 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "oobleck/analysis/data.hpp"
-#include "oobleck/io/checkpoint.hpp"
+#include "oobleck/mpm/fields.hpp"
 #include "oobleck/scene/build.hpp"
 #include "oobleck/scene/config.hpp"
 
@@ -45,35 +47,31 @@ class SceneAnalysis {
   virtual void sample() {}
   virtual void at_frame() {}
   virtual void at_snapshot(const SnapshotFields&) {}
-  /// Write the analysis's state into a checkpoint (the runner's CheckpointWriter, before commit).
-  void save(io::CheckpointWriter& cp) const;
-  virtual void restore(const io::Checkpoint&) {}
+  /// Declare the analysis's persistent state (group "analysis"): the kind's own, then the
+  /// settling sums, which "oobleck-checkpoint-1" keeps in every file (zero for the other kinds).
+  void declare_fields(mpm::FieldList& list) {
+    list.group("analysis");
+    declare_state(list);
+    list.add_attribute("settle_sum", settling_.sum, "m/s");
+    list.add_attribute("settle_samples", settling_.samples, "1");
+  }
   /// Keys for summary.json (an object; empty when there is nothing to report).
   virtual nlohmann::json result() const { return nlohmann::json::object(); }
 
  protected:
-  virtual void save_state(io::CheckpointWriter&) const {}
-  /// The settling analysis's sums (checkpoint format 1 keeps them in every file, below).
+  /// The kind's sampled state (arrays, growing series, attributes).
+  virtual void declare_state(mpm::FieldList&) {}
+  /// The settling analysis's running sum of the settling velocity and its sample count.
   struct SettlingSums {
     double sum = 0.0;
-    long samples = 0;
+    std::int64_t samples = 0;
   };
-  virtual SettlingSums settling_sums() const { return {}; }
+  SettlingSums settling_;
 
   mpm::Solver<G>& solver() const { return *scene_.solver; }
   const scene::SceneConfig& cfg_;
   const scene::BuiltScene<G>& scene_;
 };
-
-template <class G>
-void SceneAnalysis<G>::save(io::CheckpointWriter& cp) const {
-  // "oobleck-checkpoint-1" has the settling sums in every file, zero for the other kinds: the
-  // binaries before the analyses had their own units read them on every restart.
-  const SettlingSums s = settling_sums();
-  cp.attribute("settle_sum", s.sum);
-  cp.attribute("settle_samples", static_cast<std::int64_t>(s.samples));
-  save_state(cp);
-}
 
 /// The analysis of `config.analysis.kind` (kind none: one that measures nothing).
 template <class G>

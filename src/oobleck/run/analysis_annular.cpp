@@ -33,16 +33,19 @@ class AnnularAnalysis final : public SceneAnalysis<G> {
     if constexpr (G::ncomp == 3 && D == 2) sample_frame();
   }
 
-  void restore(const io::Checkpoint& cp) override;
   nlohmann::json result() const override;
 
  protected:
-  void save_state(io::CheckpointWriter& cp) const override {
-    save_field_frames(cp, "analysis/shear", frames_,
-                      [](const analysis::ShearFrame& f) -> const analysis::GridField2D& { return f.v_theta; });
-    if (!frames_.empty() && !frames_.front().f.values.empty())
-      save_field_frames(cp, "analysis/shear_f", frames_,
-                        [](const analysis::ShearFrame& f) -> const analysis::GridField2D& { return f.f; });
+  /// "analysis/shear" (v_theta) and "analysis/shear_f" (f, when sampled) of the frames.
+  void declare_state(mpm::FieldList& list) override {
+    if constexpr (D == 2) {
+      const auto shape = node_field_shape(this->solver().grid());
+      declare_field_frames(list, "shear", frames_, shape, "m/s",
+                           [](analysis::ShearFrame& f) -> analysis::GridField2D& { return f.v_theta; });
+      declare_field_frames(
+          list, "shear_f", frames_, shape, "1", [](analysis::ShearFrame& f) -> analysis::GridField2D& { return f.f; },
+          false);
+    }
   }
 
  private:
@@ -88,26 +91,6 @@ void AnnularAnalysis<G>::sample_frame() {
                             [&](std::size_t, std::int64_t p) { return law->f[static_cast<std::size_t>(p)]; });
   }
   frames_.push_back(std::move(fr));
-}
-
-template <class G>
-void AnnularAnalysis<G>::restore(const io::Checkpoint& cp) {
-  if constexpr (D == 2) {
-    const auto shape = node_field_shape(this->solver().grid());
-    restore_field_frames(cp, "analysis/shear", shape, frames_, [](double t, analysis::GridField2D f, std::size_t) {
-      analysis::ShearFrame fr;
-      fr.time_s = t;
-      fr.v_theta = std::move(f);
-      return fr;
-    });
-    std::vector<analysis::GridField2D> shear_f;
-    restore_field_frames(cp, "analysis/shear_f", shape, shear_f,
-                         [](double, analysis::GridField2D f, std::size_t) { return f; });
-    if (!shear_f.empty() && shear_f.size() != frames_.size())
-      throw InputError(fmt::format("{}: 'analysis/shear_f' has {} frames, 'analysis/shear' {}", cp.file(),
-                                   shear_f.size(), frames_.size()));
-    for (std::size_t k = 0; k < shear_f.size(); ++k) frames_[k].f = std::move(shear_f[k]);
-  }
 }
 
 template <class G>

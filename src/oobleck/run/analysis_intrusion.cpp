@@ -32,22 +32,18 @@ class IntrusionAnalysis final : public SceneAnalysis<G> {
     if constexpr (D == 2) sample_fields();
   }
 
-  void restore(const io::Checkpoint& cp) override {
-    if constexpr (D == 2) {
-      const auto shape = node_field_shape(this->solver().grid());
-      restore_intrusion_frames(cp, "analysis/uz", shape, uz_frames_);
-      restore_intrusion_frames(cp, "analysis/f", shape, f_frames_);
-    }
-    track_.restore(cp);
-  }
-
   nlohmann::json result() const override;
 
  protected:
-  void save_state(io::CheckpointWriter& cp) const override {
-    save_intrusion_frames(cp, "analysis/uz", uz_frames_);
-    save_intrusion_frames(cp, "analysis/f", f_frames_);
-    track_.save(cp);
+  /// "analysis/uz", "analysis/f" (the sampled fields with the tip) and the track.
+  void declare_state(mpm::FieldList& list) override {
+    if constexpr (D == 2) {
+      const auto shape = node_field_shape(this->solver().grid());
+      auto field = [](analysis::IntrusionFrame& f) -> analysis::GridField2D& { return f.field; };
+      declare_field_frames(list, "uz", uz_frames_, shape, "m/s", field);
+      declare_field_frames(list, "f", f_frames_, shape, "1", field);
+    }
+    track_.declare_fields(list);
   }
 
  private:

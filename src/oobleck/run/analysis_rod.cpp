@@ -44,12 +44,10 @@ class RodAnalysis final : public SceneAnalysis<G> {
     }
   }
 
-  void restore(const io::Checkpoint& cp) override { track_.restore(cp); }
-
   nlohmann::json result() const override;
 
  protected:
-  void save_state(io::CheckpointWriter& cp) const override { track_.save(cp); }
+  void declare_state(mpm::FieldList& list) override { track_.declare_fields(list); }
 
  private:
   BodyTrack<G> track_;

@@ -44,13 +44,8 @@ class SettlingAnalysis final : public SceneAnalysis<G> {
     const double vf = mean_v(this->solver().body(scene_.fluid), vol_f);
     const double phi = reg.phi;
     const double j = phi * vs + (1.0 - phi) * vf;
-    sum_ += -(vs - j);
-    ++samples_;
-  }
-
-  void restore(const io::Checkpoint& cp) override {
-    sum_ = cp.real_attribute("settle_sum");
-    samples_ = static_cast<long>(cp.int_attribute("settle_samples"));
+    this->settling_.sum += -(vs - j);
+    ++this->settling_.samples;
   }
 
   nlohmann::json result() const override {
@@ -73,18 +68,12 @@ class SettlingAnalysis final : public SceneAnalysis<G> {
       w = w_new;
     }
     nlohmann::json a = nlohmann::json::object();
-    a["settling_velocity"] = samples_ > 0 ? sum_ / static_cast<double>(samples_) : NAN;
+    const auto [sum, samples] = this->settling_;  // (checkpointed by the base, run/analysis.hpp)
+    a["settling_velocity"] = samples > 0 ? sum / static_cast<double>(samples) : NAN;
     a["settling_velocity_analytic"] = (1.0 - phi) * w;
-    a["settling_samples"] = samples_;
+    a["settling_samples"] = samples;
     return a;
   }
-
- protected:
-  typename Base::SettlingSums settling_sums() const override { return {sum_, samples_}; }
-
- private:
-  double sum_ = 0.0;  ///< sum of the per-step settling velocities [m/s]
-  long samples_ = 0;  ///< steps summed
 };
 
 }  // namespace

@@ -40,35 +40,35 @@ class WheelAnalysis final : public SceneAnalysis<G> {
     if (r.points > 0) scatter_.push_back({this->solver().time_s(), r});  // else no grains under the wheel
   }
 
-  void restore(const io::Checkpoint& cp) override {
-    if (cp.has("analysis/pressure_scatter")) {
-      const auto& flat = cp.doubles("analysis/pressure_scatter");
-      for (std::size_t o = 0; o + 6 <= flat.size(); o += 6) {
-        ScatterSample r;
-        r.t = flat[o];
-        r.s.relative = flat[o + 1];
-        r.s.rms_deviation_Pa = flat[o + 2];
-        r.s.rms_Pa = flat[o + 3];
-        r.s.points = static_cast<std::int64_t>(flat[o + 4]);
-        r.s.cells = static_cast<std::int64_t>(flat[o + 5]);
-        scatter_.push_back(r);
-      }
-    }
-    track_.restore(cp);
-  }
-
   nlohmann::json result() const override;
 
  protected:
-  void save_state(io::CheckpointWriter& cp) const override {
-    if (!scatter_.empty()) {  // one row of 6 per frame
-      std::vector<double> flat;
-      for (const auto& r : scatter_)
-        flat.insert(flat.end(), {r.t, r.s.relative, r.s.rms_deviation_Pa, r.s.rms_Pa, static_cast<double>(r.s.points),
-                                 static_cast<double>(r.s.cells)});
-      cp.array("analysis/pressure_scatter", flat);
-    }
-    track_.save(cp);
+  /// "analysis/pressure_scatter" (one row of 6 per frame: t, relative, rms deviation, rms,
+  /// points, cells) and the track.
+  void declare_state(mpm::FieldList& list) override {
+    list.add_series(
+        "pressure_scatter", "SI",
+        [this] {
+          std::vector<double> flat;
+          for (const auto& r : scatter_)
+            flat.insert(flat.end(), {r.t, r.s.relative, r.s.rms_deviation_Pa, r.s.rms_Pa,
+                                     static_cast<double>(r.s.points), static_cast<double>(r.s.cells)});
+          return flat;
+        },
+        [this](const std::vector<double>& flat) {
+          scatter_.clear();
+          for (std::size_t o = 0; o + 6 <= flat.size(); o += 6) {
+            ScatterSample r;
+            r.t = flat[o];
+            r.s.relative = flat[o + 1];
+            r.s.rms_deviation_Pa = flat[o + 2];
+            r.s.rms_Pa = flat[o + 3];
+            r.s.points = static_cast<std::int64_t>(flat[o + 4]);
+            r.s.cells = static_cast<std::int64_t>(flat[o + 5]);
+            scatter_.push_back(r);
+          }
+        });
+    track_.declare_fields(list);
   }
 
  private:

@@ -1,14 +1,14 @@
 #pragma once
 // The track of the analysed [[body]] (intrusion, rod, wheel analyses): at every sample its
 // centre of mass, mean velocity, mean contact force since the previous sample, extreme
-// coordinate along the last axis and motor state; checkpointed as "analysis/track" (one row of
+// coordinate along the last axis and motor state; persistent as "analysis/track" (one row of
 // 4 + D + 2 NC numbers per sample), "analysis/track_impulse" and the attribute "track_time".
 #include <algorithm>
 #include <cmath>
 #include <type_traits>
 #include <vector>
 
-#include "oobleck/io/checkpoint.hpp"
+#include "oobleck/mpm/fields.hpp"
 #include "oobleck/run/nodal_fields.hpp"
 #include "oobleck/scene/build.hpp"
 
@@ -58,37 +58,40 @@ class BodyTrack {
     track_.push_back(s);
   }
 
-  void save(io::CheckpointWriter& cp) const {
-    if (track_.empty()) return;
-    std::vector<double> flat;
-    for (const auto& t : track_) {
-      flat.insert(flat.end(), {t.t, t.bottom, t.omega, t.torque});
-      flat.insert(flat.end(), t.centre.data(), t.centre.data() + D);
-      flat.insert(flat.end(), t.velocity.data(), t.velocity.data() + NC);
-      flat.insert(flat.end(), t.force.data(), t.force.data() + NC);
-    }
-    cp.array("analysis/track", flat);
-    cp.array("analysis/track_impulse", std::span<const double>(impulse_.data(), NC));
-    cp.attribute("track_time", time_);
-  }
-
-  void restore(const io::Checkpoint& cp) {
-    if (!cp.has("analysis/track")) return;
-    const auto& flat = cp.doubles("analysis/track");
-    const std::size_t w = 4 + D + 2 * NC;
-    for (std::size_t o = 0; o + w <= flat.size(); o += w) {
-      Sample t;
-      t.t = flat[o];
-      t.bottom = flat[o + 1];
-      t.omega = flat[o + 2];
-      t.torque = flat[o + 3];
-      for (int k = 0; k < D; ++k) t.centre[k] = flat[o + 4 + k];
-      for (int k = 0; k < NC; ++k) t.velocity[k] = flat[o + 4 + D + k];
-      for (int k = 0; k < NC; ++k) t.force[k] = flat[o + 4 + D + NC + k];
-      track_.push_back(t);
-    }
-    cp.read_into("analysis/track_impulse", std::span<double>(impulse_.data(), NC));
-    time_ = cp.real_attribute("track_time");
+  /// Persistent state (call with the list's group "analysis"): the samples as "track", one row
+  /// of 4 + D + 2 NC numbers each (t, bottom, omega, torque, centre, velocity, force), the
+  /// impulse sum at the last sample "track_impulse" and its time, attribute "track_time".
+  void declare_fields(mpm::FieldList& list) {
+    constexpr std::size_t w = 4 + D + 2 * NC;
+    list.add_series(
+        "track", "SI",
+        [this] {
+          std::vector<double> flat;
+          flat.reserve(track_.size() * w);
+          for (const auto& t : track_) {
+            flat.insert(flat.end(), {t.t, t.bottom, t.omega, t.torque});
+            flat.insert(flat.end(), t.centre.data(), t.centre.data() + D);
+            flat.insert(flat.end(), t.velocity.data(), t.velocity.data() + NC);
+            flat.insert(flat.end(), t.force.data(), t.force.data() + NC);
+          }
+          return flat;
+        },
+        [this](const std::vector<double>& flat) {
+          track_.clear();
+          for (std::size_t o = 0; o + w <= flat.size(); o += w) {
+            Sample t;
+            t.t = flat[o];
+            t.bottom = flat[o + 1];
+            t.omega = flat[o + 2];
+            t.torque = flat[o + 3];
+            for (int k = 0; k < D; ++k) t.centre[k] = flat[o + 4 + k];
+            for (int k = 0; k < NC; ++k) t.velocity[k] = flat[o + 4 + D + k];
+            for (int k = 0; k < NC; ++k) t.force[k] = flat[o + 4 + D + NC + k];
+            track_.push_back(t);
+          }
+        });
+    list.add_values("track_impulse", {impulse_.data(), NC}, "N s");
+    list.add_attribute("track_time", time_, "s");
   }
 
  private:

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <type_traits>
 #include <variant>
 
@@ -73,32 +74,39 @@ io::PointCloud body_cloud(const scene::BuiltScene<G>& scene, int b, Columns& col
   return cloud;
 }
 
-/// Nodal porosity on the physical nodes (x fastest).
+/// The solver's nodal frame fields (Solver::declare_grid_fields) on the physical nodes (x
+/// fastest); nullopt when it declares none.
 template <class G>
-io::NodeGrid porosity_grid(const scene::BuiltScene<G>& scene, Columns& column) {
+std::optional<io::NodeGrid> node_grid(const scene::BuiltScene<G>& scene, Columns& column) {
   constexpr int D = G::dim;
-  const auto& n_nodal = scene.solver->nodal_porosity();
+  mpm::FieldList list;
+  scene.solver->declare_grid_fields(list);
+  const std::vector<const mpm::PersistentField*> shown = list.frame_fields();
+  if (shown.empty()) return std::nullopt;
   const auto& grid = scene.solver->grid();
   std::array<std::size_t, 3> nodes{1, 1, 1};
   for (int a = 0; a < D; ++a) nodes[a] = static_cast<std::size_t>(grid.periodic[a] ? grid.cells[a] : grid.cells[a] + 1);
-  auto& values = column.add(nodes[0] * nodes[1] * nodes[2]);
-  for (std::size_t k = 0; k < nodes[2]; ++k) {
-    for (std::size_t j = 0; j < nodes[1]; ++j) {
-      for (std::size_t i = 0; i < nodes[0]; ++i) {
-        const int logical[3] = {static_cast<int>(i), static_cast<int>(j), static_cast<int>(k)};
-        int flat = 0;
-        for (int a = 0; a < D; ++a) flat += grid.storage_index(a, logical[a]) * grid.stride(a);
-        values[i + nodes[0] * (j + nodes[1] * k)] = n_nodal[static_cast<std::size_t>(flat)];
-      }
-    }
-  }
   std::array<double, 3> origin{0, 0, 0}, spacing{0, 0, 0};
   for (int a = 0; a < D; ++a) {
     origin[a] = grid.origin_m[a];
     spacing[a] = grid.h_m;
   }
   io::NodeGrid ng(D, origin, spacing, nodes);
-  ng.scalar("porosity", values);
+  for (const mpm::PersistentField* f : shown) {
+    const auto& stored = std::get<std::span<double>>(f->data);
+    auto& values = column.add(nodes[0] * nodes[1] * nodes[2]);
+    for (std::size_t k = 0; k < nodes[2]; ++k) {
+      for (std::size_t j = 0; j < nodes[1]; ++j) {
+        for (std::size_t i = 0; i < nodes[0]; ++i) {
+          const int logical[3] = {static_cast<int>(i), static_cast<int>(j), static_cast<int>(k)};
+          int flat = 0;
+          for (int a = 0; a < D; ++a) flat += grid.storage_index(a, logical[a]) * grid.stride(a);
+          values[i + nodes[0] * (j + nodes[1] * k)] = stored[static_cast<std::size_t>(flat)];
+        }
+      }
+    }
+    ng.scalar(f->shown_as(), values);
+  }
   return ng;
 }
 
@@ -112,7 +120,7 @@ void write_frame(io::FrameWriter& frames, const scene::BuiltScene<G>& scene) {
   frame.step = solver.steps();
   Columns column(64 * static_cast<std::size_t>(solver.body_count()) + 16);
   for (int b = 0; b < solver.body_count(); ++b) frame.bodies.push_back(body_cloud(scene, b, column));
-  if (!solver.nodal_porosity().empty()) frame.grid = porosity_grid(scene, column);
+  if (auto grid = node_grid(scene, column)) frame.grid = std::move(*grid);
   frames.write(frame);
 }
 

@@ -23,7 +23,7 @@
 #include "oobleck/run/run_output.hpp"
 #include "oobleck/run/run_summary.hpp"
 #include "oobleck/run/snapshots.hpp"
-#include "oobleck/run/solver_state.hpp"
+#include "oobleck/run/checkpoint_state.hpp"
 #include "oobleck/scene/build.hpp"
 #include "oobleck/scene/third_bodies.hpp"
 
@@ -61,7 +61,9 @@ class SceneRun {
   void write_frame(io::FrameWriter& frames);
   void take_due_snapshots(bool final_step);
   void check_finite() const;
-  void write_checkpoint() const;
+  /// Everything a restart needs (run/checkpoint_state.hpp): solver, snapshots, analysis.
+  mpm::FieldList state_fields();
+  void write_checkpoint();
   void restore(const io::Checkpoint& cp);
   nlohmann::json summary(long steps_run, bool complete, double wall_s) const;
 
@@ -133,16 +135,22 @@ void SceneRun<G>::check_finite() const {
 }
 
 template <class G>
-void SceneRun<G>::write_checkpoint() const {
+mpm::FieldList SceneRun<G>::state_fields() {
+  mpm::FieldList list = solver_fields(scene_);
+  snapshots_.declare_fields(list);
+  analysis_->declare_fields(list);
+  return list;
+}
+
+template <class G>
+void SceneRun<G>::write_checkpoint() {
   io::CheckpointWriter cp(checkpoint_path(opt_.out_dir));
   cp.set_step(solver().steps());
   cp.set_time(solver().time_s());
   cp.set_config(cfg_.resolved_toml);
   cp.attribute("dt", scene_.dt_s);
   cp.attribute("threads", static_cast<std::int64_t>(solver().threads()));
-  save_solver_state(cp, scene_);
-  snapshots_.save(cp);
-  analysis_->save(cp);
+  save_fields(cp, state_fields());
   cp.commit();
 }
 
@@ -152,9 +160,7 @@ void SceneRun<G>::restore(const io::Checkpoint& cp) {
     throw InputError(fmt::format("{}: time step {} s differs from the checkpoint's {} s", cp.file(), scene_.dt_s,
                                  cp.real_attribute("dt")));
   }
-  restore_solver_state(cp, scene_);
-  snapshots_.restore(cp);
-  analysis_->restore(cp);
+  restore_fields(cp, state_fields());
   solver().set_clock(cp.time(), cp.step());
 }
 

@@ -7,7 +7,6 @@
 
 #include "oobleck/io/output_file.hpp"
 #include "oobleck/run/nodal_fields.hpp"
-#include "oobleck/run/solver_state.hpp"
 
 namespace oobleck::run {
 
@@ -24,8 +23,9 @@ bool Snapshots<G>::due(bool final_step) const {
     return false;  // the configuration allows snapshot_times on 2D grids only
   } else {
     const auto& times = cfg_.analysis.snapshot_times_s;
-    return next_ < times.size() && (scene_.solver->time_s() >= times[next_] - 0.5 * scene_.dt_s ||
-                                    (final_step && times[next_] <= cfg_.time.duration_s));
+    const auto next = static_cast<std::size_t>(next_);
+    return next < times.size() && (scene_.solver->time_s() >= times[next] - 0.5 * scene_.dt_s ||
+                                   (final_step && times[next] <= cfg_.time.duration_s));
   }
 }
 
@@ -93,29 +93,29 @@ SnapshotFields Snapshots<G>::write_next() {
                             s.f.values[k], s.p_grains.values[k], phi);
       }
     }
-    const std::string name = fmt::format("snapshot_{}.csv", next_);
-    io::write_file_atomically(out_dir_ + "/" + name,
-                              fmt::format("# t = {:.9g} s (requested {:.9g} s), step {}\n", solver.time_s(),
-                                          cfg_.analysis.snapshot_times_s[next_], solver.steps()) +
-                                  text,
-                              "snapshot");
-    files_.push_back(name);
+    io::write_file_atomically(
+        out_dir_ + "/" + file_name(next_),
+        fmt::format("# t = {:.9g} s (requested {:.9g} s), step {}\n", solver.time_s(),
+                    cfg_.analysis.snapshot_times_s[static_cast<std::size_t>(next_)], solver.steps()) +
+            text,
+        "snapshot");
     ++next_;
   }
   return s;
 }
 
 template <class G>
-void Snapshots<G>::save(io::CheckpointWriter& cp) const {
-  if (!x0_grains_.empty()) cp.array("analysis/x0_grains", as_doubles(x0_grains_));
-  cp.attribute("next_snapshot", static_cast<std::int64_t>(next_));
+std::vector<std::string> Snapshots<G>::files() const {
+  std::vector<std::string> names;
+  for (std::int64_t k = 0; k < next_; ++k) names.push_back(file_name(k));
+  return names;
 }
 
 template <class G>
-void Snapshots<G>::restore(const io::Checkpoint& cp) {
-  if (!x0_grains_.empty()) cp.read_into("analysis/x0_grains", as_doubles(x0_grains_));
-  next_ = static_cast<std::size_t>(cp.int_attribute("next_snapshot"));
-  for (std::size_t k = 0; k < next_; ++k) files_.push_back(fmt::format("snapshot_{}.csv", k));
+void Snapshots<G>::declare_fields(mpm::FieldList& list) {
+  list.group("analysis");
+  if (!x0_grains_.empty()) list.add("x0_grains", x0_grains_, "m");
+  list.add_attribute("next_snapshot", next_, "1");
 }
 
 template class Snapshots<mpm::PlaneStrain>;

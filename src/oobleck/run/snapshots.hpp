@@ -3,11 +3,13 @@
 // snapshot_<k>.csv with the mixture velocity, the grains' displacement since t = 0, f, p~ and phi
 // on the physical nodes. The grains' initial positions and the snapshot counter are checkpointed
 // ("analysis/x0_grains", attribute "next_snapshot").
-#include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
-#include "oobleck/io/checkpoint.hpp"
+#include <fmt/format.h>
+
+#include "oobleck/mpm/fields.hpp"
 #include "oobleck/run/analysis.hpp"
 #include "oobleck/scene/build.hpp"
 
@@ -26,20 +28,21 @@ class Snapshots {
   /// Write the next snapshot's file and return its fields.
   SnapshotFields write_next();
   /// The files written so far (for summary.json "snapshots").
-  const std::vector<std::string>& files() const { return files_; }
+  std::vector<std::string> files() const;
 
-  void save(io::CheckpointWriter& cp) const;
-  void restore(const io::Checkpoint& cp);
+  /// The initial grain positions "analysis/x0_grains" and the attribute "next_snapshot"
+  /// (mpm/fields.hpp).
+  void declare_fields(mpm::FieldList& list);
 
  private:
   SnapshotFields fields() const;
+  static std::string file_name(std::int64_t k) { return fmt::format("snapshot_{}.csv", k); }
 
   const scene::SceneConfig& cfg_;
   const scene::BuiltScene<G>& scene_;
   std::string out_dir_;
   std::vector<mpm::Vec<G::dim>> x0_grains_;  ///< initial grain positions (displacements)
-  std::size_t next_ = 0;                     ///< index of the next snapshot time
-  std::vector<std::string> files_;
+  std::int64_t next_ = 0;                    ///< index of the next snapshot time
 };
 
 extern template class Snapshots<mpm::PlaneStrain>;
