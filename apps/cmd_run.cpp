@@ -7,6 +7,7 @@
 #include "cli_common.hpp"
 #include "oobleck/core/error.hpp"
 #include "oobleck/run/runner.hpp"
+#include "oobleck/run/stop.hpp"
 #include "oobleck/scene/config.hpp"
 
 namespace oobleck::cli {
@@ -58,6 +59,7 @@ void add_run_command(CLI::App& app) {
       // The run folder and its parents are created by the run once the scene and the solver have
       // been set up (out/ in a fresh checkout), so a refused scene leaves nothing behind.
     }
+    const run::StopOnSignals stop_on_signals;  // Ctrl-C: checkpoint, summary, exit 130 (main.cpp)
     const auto summary = run::run_scene(cfg, ro);
     fmt::print("{}: {} points x {} steps in {:.3g} s = {:.3g} point updates/s on {} thread(s); output in {}\n",
                cfg.name, summary["points"].get<long>(), summary["steps_this_run"].get<long>(),

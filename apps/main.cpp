@@ -1,5 +1,8 @@
 // oobleck: simulator for dense, fine-particle suspensions (Baumgarten & Kamrin 2019).
-// Exit status: 0 success, 1 usage error, 2 bad input (file/key/value named), 3 numerical failure.
+// Exit status: 0 success, 1 usage error, 2 bad input (file/key/value named), 3 numerical failure
+// or an output that could not be written, 128 + N a run stopped by signal N (130: SIGINT, 143:
+// SIGTERM) after writing its checkpoint.
+#include <csignal>
 #include <cstdio>
 #include <exception>
 
@@ -9,8 +12,12 @@
 #include "cli_common.hpp"
 #include "oobleck/core/build_info.hpp"
 #include "oobleck/core/error.hpp"
+#include "oobleck/run/stop.hpp"
 
 int main(int argc, char** argv) {
+  // A write past a file-size limit (ulimit -f) fails with EFBIG and is reported with the file's
+  // name, instead of the signal ending the process mid-write.
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{"oobleck — dense suspension simulator (Baumgarten–Kamrin 2019 model)"};
   app.require_subcommand(1);
   app.set_version_flag("--version", oobleck::version_string());
@@ -22,6 +29,9 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const oobleck::run::Stopped& e) {
+    fmt::print(stderr, "oobleck: {}\n", e.what());
+    return 128 + e.signal();
   } catch (const oobleck::InputError& e) {
     fmt::print(stderr, "oobleck: error: {}\n", e.what());
     return 2;

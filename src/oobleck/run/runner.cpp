@@ -16,6 +16,7 @@
 #include "oobleck/io/frames.hpp"
 #include "oobleck/io/output_file.hpp"
 #include "oobleck/io/progress.hpp"
+#include "oobleck/io/run_lock.hpp"
 #include "oobleck/io/series.hpp"
 #include "oobleck/io/summary.hpp"
 #include "oobleck/run/analysis.hpp"
@@ -23,6 +24,7 @@
 #include "oobleck/run/run_output.hpp"
 #include "oobleck/run/run_summary.hpp"
 #include "oobleck/run/snapshots.hpp"
+#include "oobleck/run/stop.hpp"
 #include "oobleck/run/checkpoint_state.hpp"
 #include "oobleck/scene/build.hpp"
 #include "oobleck/scene/third_bodies.hpp"
@@ -56,7 +58,7 @@ class SceneRun {
   long steps_between(double interval_s, long fallback) const {
     return interval_s > 0 ? std::max(1L, static_cast<long>(std::llround(interval_s / scene_.dt_s))) : fallback;
   }
-  void make_run_folder() const;
+  void make_run_folder();
   void start(std::optional<io::FrameWriter>& frames, std::optional<io::SeriesWriter>& series);
   void write_frame(io::FrameWriter& frames);
   void take_due_snapshots(bool final_step);
@@ -74,15 +76,17 @@ class SceneRun {
   scene::BuiltScene<G> scene_;
   std::unique_ptr<SceneAnalysis<G>> analysis_;
   Snapshots<G> snapshots_;
+  std::optional<io::RunFolderLock> lock_;  ///< held from before the first write to the end
 };
 
 template <class G>
-void SceneRun<G>::make_run_folder() const {
+void SceneRun<G>::make_run_folder() {
   std::error_code ec;
   fs::create_directories(opt_.out_dir, ec);
   if (ec || !fs::is_directory(opt_.out_dir))
     throw InputError(fmt::format("--out {}: cannot create the run folder: {}", opt_.out_dir,
                                  ec ? ec.message() : "a file of that name is in the way"));
+  lock_.emplace(opt_.out_dir);
 }
 
 /// Open the frames and the series: continued from the checkpoint on a restart (whose analysis
@@ -187,9 +191,10 @@ nlohmann::json SceneRun<G>::run() {
   io::Progress progress(static_cast<std::uint64_t>(total), po);
 
   const long first = static_cast<long>(solver().steps());
-  const long last = opt_.stop_after_steps >= 0 ? std::min<long>(opt_.stop_after_steps, total) : total;
+  long last = opt_.stop_after_steps >= 0 ? std::min<long>(opt_.stop_after_steps, total) : total;
   solver().reset_timings();
   const auto t0 = std::chrono::steady_clock::now();
+  bool stopped = false;
   for (long s = first + 1; s <= last; ++s) {
     for (const auto& tb : scene_.third)  // prescribed bodies ramping up to speed
       if (tb.cfg->ramp_time_s > 0.0)
@@ -205,14 +210,25 @@ nlohmann::json SceneRun<G>::run() {
     if (s % every_series == 0 || final_step) series->row(series_row(scene_));
     if (every_cp > 0 && s % every_cp == 0) write_checkpoint();
     progress.update(static_cast<std::uint64_t>(s), solver().time_s());
+    if (stop_requested() && s < last) {  // run/stop.hpp: after this step's output
+      last = s;
+      stopped = true;
+    }
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (last < total) write_checkpoint();  // stopped early: leave a checkpoint to continue from
   progress.finish();
   frames->flush();
 
-  const nlohmann::json j = summary(last - first, last == total, wall);
+  nlohmann::json j = summary(last - first, last == total, wall);
+  if (stopped) j["stopped_by"] = stop_reason(stop_signal());
   io::write_summary(opt_.out_dir, j);
+  if (stopped) {
+    throw Stopped(fmt::format("{}: stopped by {} after step {} (t = {:.6g} s); the checkpoint is written: continue "
+                              "with `oobleck run --restart {}`",
+                              cfg_.name, stop_reason(stop_signal()), last, solver().time_s(), opt_.out_dir),
+                  stop_signal());
+  }
   return j;
 }
 
