@@ -1,0 +1,214 @@
+// Faults during `oobleck run` (docs/reliability.md): a stop by SIGINT or SIGTERM leaves a
+// checkpoint and a summary marked incomplete and continues bit for bit on --restart; SIGKILL at
+// any moment leaves a checkpoint that restarts and an index that lists only complete frames; a
+// file-size limit is a clear error naming the file with the previous checkpoint intact; a second
+// run into a folder in use is refused.
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.hpp"
+#include "oobleck/core/error.hpp"
+#include "oobleck/io/checkpoint.hpp"
+
+extern char** environ;
+
+namespace fs = std::filesystem;
+using namespace oobleck;
+
+namespace {
+
+const std::string kSettling = std::string(OOBLECK_SOURCE_DIR) + "/scenes/verification/settling.toml";
+
+/// `oobleck run ARGS` started in the background, its output into `log`.
+class Child {
+ public:
+  Child(const std::vector<std::string>& args, const std::string& log) {
+    std::vector<std::string> argv_s = {OOBLECK_CLI, "run"};
+    argv_s.insert(argv_s.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (auto& a : argv_s) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&fa, 1, 2);
+    if (posix_spawn(&pid_, argv[0], &fa, nullptr, argv.data(), environ) != 0) pid_ = -1;
+    posix_spawn_file_actions_destroy(&fa);
+  }
+  ~Child() {
+    if (pid_ > 0 && !waited_) {
+      ::kill(pid_, SIGKILL);
+      wait();
+    }
+  }
+  Child(const Child&) = delete;
+  Child& operator=(const Child&) = delete;
+
+  pid_t pid() const { return pid_; }
+  void signal(int s) const { ::kill(pid_, s); }
+  /// Exit status, or 128 + the signal that ended it.
+  int wait() {
+    int st = 0;
+    ::waitpid(pid_, &st, 0);
+    waited_ = true;
+    return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+  }
+
+ private:
+  pid_t pid_ = -1;
+  bool waited_ = false;
+};
+
+/// Wait (up to 60 s) until `path` exists and holds at least `lines` lines.
+bool wait_for_lines(const std::string& path, int lines) {
+  for (int k = 0; k < 6000; ++k) {
+    std::ifstream in(path);
+    int n = 0;
+    for (std::string l; std::getline(in, l);) ++n;
+    if (n >= lines) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return false;
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+nlohmann::json summary_of(const std::string& dir) { return nlohmann::json::parse(read_text(dir + "/summary.json")); }
+
+/// Every array of two checkpoints equal bit for bit, and their clocks.
+void expect_same_state(const io::Checkpoint& a, const io::Checkpoint& b) {
+  EXPECT_EQ(a.step(), b.step());
+  EXPECT_EQ(a.time(), b.time());
+  ASSERT_EQ(a.names(), b.names());
+  for (const auto& n : a.names()) {
+    if (n == "granular/regime")
+      EXPECT_EQ(a.bytes(n), b.bytes(n)) << n;
+    else
+      EXPECT_EQ(a.doubles(n), b.doubles(n)) << n;
+  }
+}
+
+}  // namespace
+
+TEST(RunFaults, SigintAndSigtermStopWithACheckpointAndRestartBitForBit) {
+  clitest::TempDir d;
+  const std::vector<std::string> scene = {kSettling, "--set", "time.duration=1.0", "--threads", "1", "--quiet"};
+  for (int sig : {SIGINT, SIGTERM}) {
+    const std::string out = d / ("stopped" + std::to_string(sig));
+    std::vector<std::string> args = scene;
+    args.insert(args.end(), {"--out", out, "--set", "output.series_interval=1e-4"});
+    Child run(args, d / "log");
+    ASSERT_TRUE(wait_for_lines(out + "/series.csv", 4));
+    run.signal(sig);
+    EXPECT_EQ(run.wait(), 128 + sig) << read_text(d / "log");
+    const std::string log = read_text(d / "log");
+    EXPECT_NE(log.find(sig == SIGINT ? "stopped by SIGINT" : "stopped by SIGTERM"), std::string::npos) << log;
+    EXPECT_NE(log.find("--restart " + out), std::string::npos) << log;
+    const auto s = summary_of(out);
+    EXPECT_FALSE(s["complete"].get<bool>());
+    EXPECT_EQ(s["stopped_by"], sig == SIGINT ? "SIGINT" : "SIGTERM");
+    const io::Checkpoint cp = io::read_checkpoint(out + "/checkpoint.h5");
+    EXPECT_EQ(cp.step(), s["steps"].get<std::int64_t>());
+
+    // Continued to 40 steps past the stop, it holds the state of a run never stopped.
+    const std::string until = std::to_string(cp.step() + 40);
+    const auto r = clitest::run("run --restart " + out + " --stop-after " + until + " --threads 1 --quiet");
+    ASSERT_EQ(r.status, 0) << r.output;
+    const std::string ref = d / ("ref" + std::to_string(sig));
+    const auto u = clitest::run(
+        "run " + kSettling + " --set time.duration=1.0 --set output.series_interval=1e-4 --threads 1 --quiet --out " +
+        ref + " --stop-after " + until);
+    ASSERT_EQ(u.status, 0) << u.output;
+    expect_same_state(io::read_checkpoint(ref + "/checkpoint.h5"), io::read_checkpoint(out + "/checkpoint.h5"));
+  }
+}
+
+TEST(RunFaults, SigkillAtAnyMomentLeavesARestartableCheckpointAndCompleteFrames) {
+  // Frames and checkpoints every few steps, so that kills land inside their writes too.
+  clitest::TempDir d;
+  if (clitest::shell("/usr/bin/python3 -c 'import xml.etree.ElementTree'").status != 0)
+    GTEST_SKIP() << "/usr/bin/python3 not available for tools/check_xdmf.py";
+  std::mt19937 rng(20261204);
+  std::uniform_int_distribution<int> delay_ms(30, 900);
+  int with_checkpoint = 0;
+  for (int k = 0; k < 20; ++k) {
+    const std::string out = d / ("killed" + std::to_string(k));
+    Child run({kSettling, "--set", "time.duration=1.0", "--set", "output.frame_interval=1e-4", "--checkpoint-every",
+               "3", "--threads", "1", "--quiet", "--out", out},
+              d / "log");
+    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms(rng)));
+    run.signal(SIGKILL);
+    EXPECT_EQ(run.wait(), 128 + SIGKILL);
+    if (fs::exists(out + "/frames.xmf")) {
+      const auto check = clitest::shell("/usr/bin/python3 " + std::string(OOBLECK_SOURCE_DIR) +
+                                        "/tools/check_xdmf.py --quiet '" + out + "/frames.xmf'");
+      EXPECT_EQ(check.status, 0) << "kill " << k << ": " << check.output;
+    }
+    if (!fs::exists(out + "/checkpoint.h5")) continue;  // killed before its first checkpoint
+    ++with_checkpoint;
+    io::Checkpoint cp;
+    ASSERT_NO_THROW(cp = io::read_checkpoint(out + "/checkpoint.h5")) << "kill " << k;
+    const auto r = clitest::run("run --restart " + out + " --stop-after " + std::to_string(cp.step() + 3) +
+                                " --threads 1 --quiet");
+    EXPECT_EQ(r.status, 0) << "kill " << k << ": " << r.output;
+    EXPECT_EQ(io::read_checkpoint(out + "/checkpoint.h5").step(), cp.step() + 3);
+  }
+  EXPECT_GE(with_checkpoint, 15);  // the kills fell inside the run, not only before it started
+}
+
+TEST(RunFaults, FileSizeLimitIsAClearErrorAndKeepsThePreviousCheckpoint) {
+  clitest::TempDir d;
+  const std::string out = d / "run";
+  auto r =
+      clitest::run("run " + kSettling + " --set time.duration=0.01 --stop-after 50 --threads 1 --quiet --out " + out);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string before = read_text(out + "/checkpoint.h5");
+  // The restart writes frames and a checkpoint of ~100 kB each; the limit is 16 kB per file.
+  r = clitest::shell("ulimit -f 16; exec " + std::string(OOBLECK_CLI) + " run --restart " + out +
+                     " --checkpoint-every 10 --threads 1 --quiet");
+  EXPECT_NE(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find(out), std::string::npos) << "the message names the file: " << r.output;
+  EXPECT_EQ(read_text(out + "/checkpoint.h5"), before);
+  EXPECT_EQ(io::read_checkpoint(out + "/checkpoint.h5").step(), 50);
+  for (const auto& e : fs::directory_iterator(out))
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+}
+
+TEST(RunFaults, ASecondRunIntoAFolderInUseIsRefused) {
+  clitest::TempDir d;
+  const std::string out = d / "run";
+  Child first({kSettling, "--set", "time.duration=1.0", "--set", "output.series_interval=1e-4", "--threads", "1",
+               "--quiet", "--out", out},
+              d / "log");
+  ASSERT_TRUE(wait_for_lines(out + "/series.csv", 3));
+  const std::string series = read_text(out + "/series.csv");
+  const auto second = clitest::run("run " + kSettling + " --set time.duration=0.01 --threads 1 --quiet --out " + out);
+  EXPECT_EQ(second.status, 2) << second.output;
+  EXPECT_NE(second.output.find("another oobleck run (pid " + std::to_string(first.pid()) + ")"), std::string::npos)
+      << second.output;
+  const auto restart = clitest::run("run --restart " + out + " --quiet");
+  EXPECT_EQ(restart.status, 2) << restart.output;
+  first.signal(SIGINT);
+  EXPECT_EQ(first.wait(), 130);
+  // The first run's output was not touched by the refused ones: its series only grew.
+  EXPECT_EQ(read_text(out + "/series.csv").substr(0, series.size()), series);
+  EXPECT_TRUE(summary_of(out)["stopped_by"] == "SIGINT");
+}
