@@ -1,16 +1,26 @@
 #include "oobleck/io/detail/h5.hpp"
 
+#include <atomic>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
+#include "oobleck/io/hdf5_state.hpp"
+
 namespace oobleck::io::h5 {
+
+namespace {
+std::atomic<bool> g_file_close_failed{false};
+}  // namespace
 
 bool Handle::reset() {
   if (id_ < 0) return true;
   herr_t status = 0;
   switch (H5Iget_type(id_)) {
-    case H5I_FILE: status = H5Fclose(id_); break;
+    case H5I_FILE:
+      status = H5Fclose(id_);
+      if (status < 0) g_file_close_failed = true;
+      break;
     case H5I_GROUP: status = H5Gclose(id_); break;
     case H5I_DATASET: status = H5Dclose(id_); break;
     case H5I_DATASPACE: status = H5Sclose(id_); break;
@@ -162,3 +172,7 @@ bool read_attribute(hid_t loc, const std::string& name, std::string& value) {
 }
 
 }  // namespace oobleck::io::h5
+
+namespace oobleck::io {
+bool hdf5_file_close_failed() { return h5::g_file_close_failed.load(); }
+}  // namespace oobleck::io
