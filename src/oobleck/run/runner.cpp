@@ -181,7 +181,7 @@ nlohmann::json SceneRun<G>::run() {
   io::Progress progress(static_cast<std::uint64_t>(total), po);
 
   const long first = static_cast<long>(solver().steps());
-  const long last = opt_.stop_after_steps >= 0 ? std::min<long>(opt_.stop_after_steps, total) : total;
+  long last = opt_.stop_after_steps >= 0 ? std::min<long>(opt_.stop_after_steps, total) : total;
   solver().reset_timings();
   const auto t0 = std::chrono::steady_clock::now();
   for (long s = first + 1; s <= last; ++s) {
@@ -199,6 +199,10 @@ nlohmann::json SceneRun<G>::run() {
     if (s % every_series == 0 || final_step) series->row(series_row(scene_));
     if (every_cp > 0 && s % every_cp == 0) write_checkpoint();
     progress.update(static_cast<std::uint64_t>(s), solver().time_s());
+    if (opt_.on_step && !opt_.on_step(s, total, solver().time_s())) {
+      last = s;  // the caller stops the run: a checkpoint, as for stop_after_steps
+      break;
+    }
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (last < total) write_checkpoint();  // stopped early: leave a checkpoint to continue from
