@@ -421,6 +421,24 @@ CurvesFitResult fit_curves(const std::vector<double>& phi, const std::vector<dou
     dq(static_cast<Eigen::Index>(i)) = params[i].log ? value : 1.0;
     slot(res.fitted.steady, params[i]) = value;
   }
+  // Determined, but so loosely that the value means nothing: a 1-sigma range wider than a factor
+  // of 1000 for the positive scales, 0.1 for a volume fraction, 10 for an exponent, 1 for Delta.
+  std::vector<std::string> loose;
+  for (std::size_t i = 0; i < P; ++i) {
+    const double se = std::sqrt(cov(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)));
+    const Param& q = params[i];
+    const double limit = q.log                     ? std::log(1000.0)
+                         : q.field == Param::alpha ? 10.0
+                         : q.field == Param::Delta ? 1.0
+                                                   : 0.1;
+    if (!(se <= limit)) {
+      loose.push_back(q.log ? fmt::format("{} (1 sigma: a factor {:.3g})", q.name, std::exp(std::min(se, 700.0)))
+                            : fmt::format("{} (1 sigma: +- {:.3g})", q.name, se));
+    }
+  }
+  if (!loose.empty()) {
+    throw InputError(fmt::format("{}: the data do not determine {}; {}", w, fmt::join(loose, ", "), hint));
+  }
   cov = dq.asDiagonal() * cov * dq.asDiagonal();
   res.covariance.resize(P * P);
   res.correlation.resize(P * P);
