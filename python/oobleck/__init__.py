@@ -276,7 +276,7 @@ def _read_data(data, name="data"):
         path = os.fspath(data)
         if not os.path.exists(path):
             raise InputError(f"{name} = {path!r}: no such file")
-        return pd.read_csv(path, comment="#", skipinitialspace=True), path
+        return pd.read_csv(path, comment="#", skipinitialspace=True, float_precision="round_trip"), path
     if isinstance(data, pd.DataFrame):
         return data, name
     raise InputError(f"{name} = {data!r} ({type(data).__name__}): must be a pandas DataFrame or the path of a CSV file")

@@ -127,6 +127,14 @@ struct CurvesCost {
               best_model = m;
             }
           }
+          if (!std::isfinite(best) && !by_stress) {
+            // No state is that fast (above gamma_DST or the S's turning point): the distance from the
+            // fastest state, ln tau there plus the excess rate, continues the residual as the
+            // matching state runs off to infinite stress (Ceres needs every Jacobian to evaluate).
+            const SteadyPoint f = curve.fastest_sample();
+            best = std::log(f.shear_stress) - (*ln_stress)[ku] + ((*ln_rate)[ku] - std::log(f.shear_rate));
+            best_model = f.shear_stress;
+          }
           if (!std::isfinite(best)) {
             if (failed != nullptr) *failed = k;
             return false;

@@ -1,5 +1,6 @@
 #include "oobleck/rheology/steady_states.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -60,6 +61,11 @@ std::vector<SteadyPoint> SteadyCurve::states_at(Control control, double value) c
     out.push_back(s);
   }
   return out;
+}
+
+SteadyPoint SteadyCurve::fastest_sample() const {
+  const auto k = std::max_element(ln_rate_.begin(), ln_rate_.end()) - ln_rate_.begin();
+  return steady_point_at_x(p_, phi_, x_[static_cast<std::size_t>(k)]);
 }
 
 std::vector<SteadyPoint> steady_states_at(const SteadyParams& p, double phi, Control control, double value,

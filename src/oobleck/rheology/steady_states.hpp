@@ -27,6 +27,8 @@ class SteadyCurve {
   /// Every state with that shear rate [1/s] or mixture shear stress [Pa], by increasing f: each
   /// sign change between samples refined by bisection in x to the resolution of doubles.
   std::vector<SteadyPoint> states_at(Control control, double value) const;
+  /// The sampled state of the largest shear rate (the DST asymptote's end or the S's turning point).
+  SteadyPoint fastest_sample() const;
 
  private:
   SteadyParams p_;
