@@ -63,21 +63,30 @@ void number_property(py::class_<rheology::Preset>& cls, const char* name, Get ge
 py::dict flow_curve(const rheology::Preset& p, const std::vector<double>& phis, int points) {
   if (points < 2) throw InputError(fmt::format("points = {}: must be >= 2", points));
   for (double phi : phis) rheology::validate_phi(p.steady, phi, fmt::format("phi (parameters: {})", p.name));
-  std::vector<double> c[9];
+  // The columns are filled in place, without the GIL (no copies: the call costs what the sweep does).
+  const auto rows = static_cast<py::ssize_t>(phis.size()) * points;
+  std::vector<py::array_t<double>> cols;
+  double* c[9];
+  for (int k = 0; k < 9; ++k) {
+    cols.emplace_back(rows);
+    c[k] = cols.back().mutable_data();
+  }
   {
     py::gil_scoped_release release;
+    std::size_t i = 0;
     for (double phi : phis) {
       const auto dst = rheology::shear_rate_dst(p.steady, phi);
       for (const auto& pt : rheology::flow_curve(p.steady, phi, points)) {
-        c[0].push_back(pt.phi);
-        c[1].push_back(pt.f);
-        c[2].push_back(pt.shear_rate);
-        c[3].push_back(pt.shear_stress);
-        c[4].push_back(pt.granular_pressure);
-        c[5].push_back(pt.granular_shear_stress);
-        c[6].push_back(pt.viscosity);
-        c[7].push_back(pt.eta_r);
-        c[8].push_back(dst ? *dst : kNaN);
+        c[0][i] = pt.phi;
+        c[1][i] = pt.f;
+        c[2][i] = pt.shear_rate;
+        c[3][i] = pt.shear_stress;
+        c[4][i] = pt.granular_pressure;
+        c[5][i] = pt.granular_shear_stress;
+        c[6][i] = pt.viscosity;
+        c[7][i] = pt.eta_r;
+        c[8][i] = dst ? *dst : kNaN;
+        ++i;
       }
     }
   }
@@ -85,7 +94,7 @@ py::dict flow_curve(const rheology::Preset& p, const std::vector<double>& phis, 
       "phi",       "f",     "shear_rate",    "shear_stress", "granular_pressure", "granular_shear_stress",
       "viscosity", "eta_r", "shear_rate_dst"};
   py::dict d;
-  for (int k = 0; k < 9; ++k) d[names[k]] = to_array(c[k]);
+  for (int k = 0; k < 9; ++k) d[names[k]] = cols[static_cast<std::size_t>(k)];
   return d;
 }
 

@@ -67,11 +67,11 @@ def test_residual_in_log_stress_at_measured_rate():
     truth = oobleck.load_params("hermes2016")
     start = truth.copy()
     start.a_0, start.phi_j, start.tau_star = 0.9, 0.54, 6.0
-    r = oobleck.fit("curves", synthetic(truth, CASES["hermes2016"][0], noise=0.0, stresses=np.geomspace(0.01, 3, 10)),
+    r = oobleck.fit("curves", synthetic(truth, [0.36, 0.38, 0.40, 0.42], noise=0.0, stresses=np.geomspace(0.01, 3, 10)),
                     start, parameters=["a_0", "phi_j", "tau_star"], residual="stress",
                     bounds={"phi_j": (0.5, 0.6)})
     assert r.residual_kind == "stress"
-    assert r.rms < 2e-3  # noise-free data: Ceres stops at its function tolerance near the truth
+    assert r.rms < 1e-4  # noise-free CST curves (below phi_c; near DST log stress at a rate is ill-conditioned)
     for name in r.values:
         assert r.values[name] == pytest.approx(true_value(truth, name), rel=1e-2)
 
