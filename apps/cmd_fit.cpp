@@ -20,6 +20,7 @@
 #include "oobleck/io/csv.hpp"
 #include "oobleck/io/output_file.hpp"
 #include "oobleck/rheology/fit.hpp"
+#include "oobleck/rheology/fit_curves.hpp"
 #include "oobleck/rheology/flow_curve.hpp"
 
 namespace oobleck::cli {
@@ -170,24 +171,106 @@ std::string plot_fit(const rheology::FitResult& r, const Data& d, const std::str
   return tmp;
 }
 
+/// `--kind curves`: the joint fit of whole flow curves (rheology/fit_curves.hpp).
+struct CurvesOpts {
+  std::string data, out, parameters, residual;
+  bool json = false;
+};
+
+void fit_curves_command(const CurvesOpts& o, rheology::Preset preset, const std::string& note) {
+  const io::CsvTable t = io::read_csv(o.data);
+  for (const char* c : {"phi", "shear_rate", "shear_stress"}) {
+    if (!t.has_column(c)) {
+      throw InputError(
+          fmt::format("{}: missing column '{}' (columns present: {}); --kind curves needs "
+                      "phi,shear_rate,shear_stress",
+                      o.data, c, fmt::join(t.header, ", ")));
+    }
+  }
+  rheology::CurvesFitOptions options;
+  options.where = o.data;
+  options.residual = rheology::parse_curves_residual(o.residual, "--residual");
+  if (!o.parameters.empty()) {
+    std::string item;
+    for (char c : o.parameters + ",") {
+      if (c == ',') {
+        if (!item.empty()) options.parameters.push_back(item);
+        item.clear();
+      } else if (c != ' ') {
+        item += c;
+      }
+    }
+  }
+  io::check_writable(o.out, "--out");
+  const auto r =
+      rheology::fit_curves(t.column("phi"), t.column("shear_rate"), t.column("shear_stress"), preset, options);
+  rheology::Preset fitted = r.fitted;
+  fitted.name = sanitize(fs::path(o.out).stem().string());
+  fitted.source = sanitize(fmt::format("oobleck rheology fit --kind curves to {}; base {}: {}",
+                                       fs::path(o.data).filename().string(), preset.name, preset.source));
+  std::string h = fmt::format("# oobleck parameter set fitted by: oobleck rheology fit --kind curves --data {}\n",
+                              sanitize(o.data));
+  h += fmt::format("# base set: {} ({}); every value not listed below is the base value\n", sanitize(preset.name),
+                   sanitize(preset.file));
+  h += fmt::format(
+      "# fitted values with 1-sigma standard errors ((J^T J)^-1 s^2, s^2 = 2 cost/(n - p)); residual: ln {}\n",
+      rheology::to_string(options.residual) == "rate" ? "shear rate at the measured stress"
+                                                      : "shear stress at the measured rate");
+  for (const auto& p : r.parameters) {
+    h += fmt::format("#   {} = {:.8g} +- {} {}\n", p.name, p.value, fmt_se(p.std_error), unit_of(p.name));
+  }
+  h += fmt::format("# n = {} points, p = {} parameters, rms log residual = {:.4g}\n\n", r.n, r.p, r.rms);
+  io::write_file_atomically(o.out, h + rheology::to_toml(fitted), "--out");
+  if (o.json) {
+    nlohmann::json params = nlohmann::json::object();
+    for (const auto& p : r.parameters) params[p.name] = {{"value", p.value}, {"std_error", p.std_error}};
+    nlohmann::json j = {{"kind", "curves"},
+                        {"parameters", params},
+                        {"n", r.n},
+                        {"rms", r.rms},
+                        {"iterations", r.iterations},
+                        {"base", preset.name},
+                        {"out", o.out},
+                        {"residual", rheology::to_string(options.residual)},
+                        {"correlation", r.correlation}};
+    if (!note.empty()) j["note"] = note;
+    fmt::print("{}\n", j.dump());
+    return;
+  }
+  fmt::print("base parameter set: {} ({}) [{} units]\n", preset.name, preset.file, preset.units);
+  fmt::print("fit --kind curves to {}: n = {} points, p = {} parameters; Ceres converged ({} iterations)\n", o.data,
+             r.n, r.p, r.iterations);
+  std::size_t width = 0;
+  for (const auto& p : r.parameters) width = std::max(width, p.name.size());
+  for (const auto& p : r.parameters) {
+    const double rel = std::abs(p.std_error / p.value);
+    fmt::print("  {:<{}} = {:<12.6g} +- {:<10}  {:<11}{}\n", p.name, width, p.value, fmt_se(p.std_error),
+               unit_of(p.name), std::isfinite(rel) ? fmt::format("({:.2g} %)", 100.0 * rel) : "");
+  }
+  fmt::print("rms log residual = {:.4g} (n = {}, residual: ln {})\n", r.rms, r.n,
+             rheology::to_string(options.residual));
+  fmt::print("wrote {}\n", o.out);
+}
+
 }  // namespace
 
 void add_fit_command(CLI::App& rheology) {
   auto* cmd = rheology.add_subcommand(
       "fit",
       "fit model parameters to rheometer data with Ceres: low (a_0, phi_j; E12), high (a_inf, phi_c; E13), "
-      "dst (eta_B terms; E14)");
+      "dst (eta_B terms; E14), curves (joint fit of whole flow curves)");
   struct Opts {
     ParamsOption params;
     std::string kind, data, out, png;
     int terms = 0;
     bool json = false;
+    std::string parameters, residual = "rate";
   };
   auto o = std::make_shared<Opts>();
-  cmd->add_option("--kind", o->kind, "low | high | dst")->required();
+  cmd->add_option("--kind", o->kind, "low | high | dst | curves")->required();
   cmd->add_option("--data", o->data,
                   "CSV with columns phi,viscosity [Pa s] or phi,relative_viscosity (low, high); phi,shear_rate_dst "
-                  "[1/s] (dst)")
+                  "[1/s] (dst); phi,shear_rate [1/s],shear_stress [Pa] (curves)")
       ->required();
   o->params.add_to(cmd);
   cmd->add_option("--out", o->out, "fitted parameter file (TOML) to write")->required();
@@ -196,7 +279,30 @@ void add_fit_command(CLI::App& rheology) {
                                 "dst only: number of eta_B terms to fit (default: as many as the base set has, or 1)");
   cmd->add_flag("--json", o->json,
                 "print one JSON object {\"kind\", \"parameters\": {name: {\"value\", \"std_error\"}}, \"n\", \"rms\"}");
-  cmd->callback([o, terms] {
+  auto* parameters = cmd->add_option(
+      "--parameters", o->parameters,
+      "curves only: fitted parameters, comma-separated (default a_0,phi_j,a_inf,phi_c,tau_star and every eta_B term)");
+  auto* residual = cmd->add_option("--residual", o->residual,
+                                   "curves only: rate (ln shear rate at the measured stress) or stress (ln shear "
+                                   "stress at the measured rate)");
+  cmd->callback([o, terms, parameters, residual] {
+    if (o->kind == "curves") {
+      if (terms->count() > 0) throw InputError(fmt::format("--terms = {}: only for --kind dst (not curves)", o->terms));
+      if (!o->png.empty()) throw InputError("--plot: not for --kind curves (use FitResult.plot() in Python)");
+      const bool default_base = o->params.preset.empty() && o->params.params.empty();
+      std::string note;
+      if (default_base) {
+        note =
+            fmt::format("no --preset or --params given: using the {} preset as the base parameter set", kDefaultPreset);
+        fmt::print(o->json ? stderr : stdout, "{}\n", note);
+      }
+      fit_curves_command({o->data, o->out, o->parameters, o->residual, o->json}, o->params.load(kDefaultPreset), note);
+      return;
+    }
+    for (auto* opt : {parameters, residual}) {
+      if (opt->count() > 0)
+        throw InputError(fmt::format("{}: only for --kind curves (not {})", opt->get_name(), o->kind));
+    }
     const rheology::FitKind kind = rheology::parse_fit_kind(o->kind, "--kind");
     rheology::FitOptions options;
     if (terms->count() > 0) {

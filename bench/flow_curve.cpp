@@ -19,7 +19,7 @@ static void BM_FlowCurve(benchmark::State& state, const char* preset, double phi
       benchmark::Counter(static_cast<double>(n) * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 
-BENCHMARK_CAPTURE(BM_FlowCurve, hermes2016_dst, "hermes2016", 0.47, 0.0)->Arg(400);
+BENCHMARK_CAPTURE(BM_FlowCurve, hermes2016_dst, "hermes2016", 0.47, 0.0)->Arg(400)->Arg(200);
 BENCHMARK_CAPTURE(BM_FlowCurve, singh2018b_s_shape, "singh2018b", 0.56, 0.0)->Arg(400);
 BENCHMARK_CAPTURE(BM_FlowCurve, frith1996_cst, "frith1996", 0.50, 0.0)->Arg(400);
 BENCHMARK_CAPTURE(BM_FlowCurve, hermes2016_brownian, "hermes2016", 0.47, 1.0)->Arg(400);

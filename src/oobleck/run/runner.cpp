@@ -194,7 +194,7 @@ nlohmann::json SceneRun<G>::run() {
   long last = opt_.stop_after_steps >= 0 ? std::min<long>(opt_.stop_after_steps, total) : total;
   solver().reset_timings();
   const auto t0 = std::chrono::steady_clock::now();
-  bool stopped = false;
+  std::string stopped_by;  // a caller's (on_step) or a signal's stop before the last step
   for (long s = first + 1; s <= last; ++s) {
     for (const auto& tb : scene_.third)  // prescribed bodies ramping up to speed
       if (tb.cfg->ramp_time_s > 0.0)
@@ -210,9 +210,15 @@ nlohmann::json SceneRun<G>::run() {
     if (s % every_series == 0 || final_step) series->row(series_row(scene_));
     if (every_cp > 0 && s % every_cp == 0) write_checkpoint();
     progress.update(static_cast<std::uint64_t>(s), solver().time_s());
-    if (stop_requested() && s < last) {  // run/stop.hpp: after this step's output
+    if (opt_.on_step && !opt_.on_step(s, total, solver().time_s())) {
+      if (s < last) stopped_by = "caller";  // a checkpoint, as for stop_after_steps
       last = s;
-      stopped = true;
+      break;
+    }
+    if (stop_requested() && s < last) {  // run/stop.hpp: after this step's output
+      stopped_by = stop_reason(stop_signal());
+      last = s;
+      break;
     }
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -221,9 +227,9 @@ nlohmann::json SceneRun<G>::run() {
   frames->flush();
 
   nlohmann::json j = summary(last - first, last == total, wall);
-  if (stopped) j["stopped_by"] = stop_reason(stop_signal());
+  if (!stopped_by.empty()) j["stopped_by"] = stopped_by;
   io::write_summary(opt_.out_dir, j);
-  if (stopped) {
+  if (!stopped_by.empty() && stopped_by != "caller") {
     throw Stopped(fmt::format("{}: stopped by {} after step {} (t = {:.6g} s); the checkpoint is written: continue "
                               "with `oobleck run --restart {}`",
                               cfg_.name, stop_reason(stop_signal()), last, solver().time_s(), opt_.out_dir),

@@ -2,6 +2,7 @@
 // `oobleck run`: a scene file becomes a two-phase MPM run with HDF5/XDMF frames, a CSV series of
 // global quantities, checkpoints and summary.json (issue 4, items 7–8).
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -17,6 +18,10 @@ struct RunOptions {
   bool quiet = false;          ///< no progress output
   bool restart = false;        ///< continue from out_dir/checkpoint.h5
   long stop_after_steps = -1;  ///< stop (with a checkpoint) after this many steps in total (tests)
+  /// Called after every step with (steps done, total steps, simulated time [s]); returning false
+  /// stops the run there with a checkpoint, as stop_after_steps does, and summary.json says
+  /// "stopped_by": "caller" (the Python module: Ctrl-C). Signals: run/stop.hpp.
+  std::function<bool(long, long, double)> on_step;
 };
 
 /// Run the scene to its end and return the summary (also written to out_dir/summary.json).

@@ -1,0 +1,470 @@
+#include "oobleck/rheology/fit_curves.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+
+#include <Eigen/Dense>
+#include <ceres/ceres.h>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "oobleck/core/error.hpp"
+#include "oobleck/rheology/steady_states.hpp"
+
+namespace oobleck::rheology {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kStrict = 1e-7;     ///< strict inequalities as inclusive bounds shifted by this
+constexpr double kAlphaMax = 60.0;   ///< as the dst fit
+constexpr double kCondition = 1e-9;  ///< smallest singular value / largest (scaled J): below, undetermined
+
+/// One fitted parameter: which field, and whether it is fitted through its logarithm (the
+/// positive scales a_0, a_inf, tau_star, phi_i, so that steps are relative).
+struct Param {
+  enum Field { a_0, phi_j, a_inf, phi_c, tau_star, Delta, phi_i, alpha } field;
+  int term = 0;  ///< eta_B term for phi_i, alpha
+  std::string name;
+  bool log = false;
+  double lower = -kInf, upper = kInf;  ///< natural units
+};
+
+double& slot(SteadyParams& s, const Param& q) {
+  switch (q.field) {
+    case Param::a_0: return s.a_0;
+    case Param::phi_j: return s.phi_j;
+    case Param::a_inf: return s.a_inf;
+    case Param::phi_c: return s.phi_c;
+    case Param::tau_star: return s.tau_star;
+    case Param::Delta: return s.Delta;
+    case Param::phi_i: return s.eta_B_terms[static_cast<std::size_t>(q.term)].phi_i;
+    case Param::alpha: return s.eta_B_terms[static_cast<std::size_t>(q.term)].alpha;
+  }
+  return s.a_0;  // unreachable
+}
+
+Param parse_param(const std::string& name, const Preset& base, const std::string& where) {
+  static const std::map<std::string, Param::Field> scalars = {{"a_0", Param::a_0},           {"phi_j", Param::phi_j},
+                                                              {"a_inf", Param::a_inf},       {"phi_c", Param::phi_c},
+                                                              {"tau_star", Param::tau_star}, {"Delta", Param::Delta}};
+  Param q{};
+  q.name = name;
+  if (auto it = scalars.find(name); it != scalars.end()) {
+    q.field = it->second;
+  } else {
+    int term = -1;
+    char field[16] = {0};
+    char tail = 0;
+    if (std::sscanf(name.c_str(), "eta_B[%d].%15[a-z_]%c", &term, field, &tail) == 2 &&
+        (std::string(field) == "phi_i" || std::string(field) == "alpha")) {
+      if (term < 0 || term >= static_cast<int>(base.steady.eta_B_terms.size())) {
+        throw InputError(fmt::format("{}: parameter '{}': the base set has {} eta_B term(s) (eta_B[0] .. eta_B[{}])",
+                                     where, name, base.steady.eta_B_terms.size(),
+                                     static_cast<int>(base.steady.eta_B_terms.size()) - 1));
+      }
+      q.field = std::string(field) == "phi_i" ? Param::phi_i : Param::alpha;
+      q.term = term;
+    } else {
+      const auto names = curves_parameter_names(base);
+      const std::string hint = closest_match(name, names);
+      throw InputError(fmt::format("{}: unknown parameter '{}'{}; the curves fit accepts: {}", where, name,
+                                   hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint),
+                                   fmt::join(names, ", ")));
+    }
+  }
+  q.log = q.field == Param::a_0 || q.field == Param::a_inf || q.field == Param::tau_star || q.field == Param::phi_i;
+  return q;
+}
+
+/// Points grouped by phi: each curve is sampled once per evaluation.
+struct Group {
+  double phi;
+  std::vector<int> rows;
+};
+
+struct CurvesCost {
+  const std::vector<Param>* params;
+  SteadyParams base;
+  const std::vector<Group>* groups;
+  const std::vector<double>* ln_rate;
+  const std::vector<double>* ln_stress;
+  CurvesResidual residual;
+  double max_phi;
+
+  /// The model's parameters at internal values x; false where they break a rule.
+  bool apply(const double* x, SteadyParams& s) const {
+    s = base;
+    for (std::size_t i = 0; i < params->size(); ++i) {
+      const Param& q = (*params)[i];
+      slot(s, q) = q.log ? std::exp(x[i]) : x[i];
+    }
+    return s.phi_c > 0.0 && s.phi_c < s.phi_j && s.phi_j < 1.0 && max_phi < s.phi_j && s.a_0 > 0.0 && s.a_inf > 0.0 &&
+           s.tau_star > 0.0 && std::isfinite(s.tau_star) && s.Delta >= 0.0 && s.Delta <= 1.0;
+  }
+
+  /// Residual and model value of every row; false (with `failed` the row) where a point has no
+  /// steady state at its measured stress or rate.
+  bool evaluate(const double* x, double* r, double* model, int* failed) const {
+    SteadyParams s;
+    if (!apply(x, s)) return false;
+    try {
+      for (const Group& g : *groups) {
+        const SteadyCurve curve(s, g.phi);
+        for (int k : g.rows) {
+          const auto ku = static_cast<std::size_t>(k);
+          const bool by_stress = residual == CurvesResidual::rate;  // the measured stress is given
+          const auto states = curve.states_at(by_stress ? Control::shear_stress : Control::shear_rate,
+                                              std::exp(by_stress ? (*ln_stress)[ku] : (*ln_rate)[ku]));
+          double best = kInf, best_model = 0.0;
+          for (const SteadyPoint& p : states) {
+            const double m = by_stress ? p.shear_rate : p.shear_stress;
+            const double res = std::log(m) - (by_stress ? (*ln_rate)[ku] : (*ln_stress)[ku]);
+            if (std::fabs(res) < std::fabs(best)) {
+              best = res;
+              best_model = m;
+            }
+          }
+          if (!std::isfinite(best) && !by_stress) {
+            // No state is that fast (above gamma_DST or the S's turning point): the distance from the
+            // fastest state, ln tau there plus the excess rate, continues the residual as the
+            // matching state runs off to infinite stress (Ceres needs every Jacobian to evaluate).
+            const SteadyPoint f = curve.fastest_sample();
+            best = std::log(f.shear_stress) - (*ln_stress)[ku] + ((*ln_rate)[ku] - std::log(f.shear_rate));
+            best_model = f.shear_stress;
+          }
+          if (!std::isfinite(best)) {
+            if (failed != nullptr) *failed = k;
+            return false;
+          }
+          r[k] = best;
+          if (model != nullptr) model[k] = best_model;
+        }
+      }
+    } catch (const NumericalError&) {
+      return false;
+    }
+    return true;
+  }
+
+  bool operator()(double const* const* x, double* r) const { return evaluate(x[0], r, nullptr, nullptr); }
+};
+
+}  // namespace
+
+std::string to_string(CurvesResidual r) { return r == CurvesResidual::rate ? "rate" : "stress"; }
+
+CurvesResidual parse_curves_residual(const std::string& text, const std::string& where) {
+  if (text == "rate") return CurvesResidual::rate;
+  if (text == "stress") return CurvesResidual::stress;
+  throw InputError(fmt::format(
+      "{} = '{}': must be 'rate' (ln shear rate at the measured stress) or 'stress' (ln shear stress at the "
+      "measured rate)",
+      where, text));
+}
+
+std::vector<std::string> curves_parameter_names(const Preset& base) {
+  std::vector<std::string> n = {"a_0", "phi_j", "a_inf", "phi_c", "tau_star", "Delta"};
+  for (std::size_t i = 0; i < base.steady.eta_B_terms.size(); ++i) {
+    n.push_back(fmt::format("eta_B[{}].phi_i", i));
+    n.push_back(fmt::format("eta_B[{}].alpha", i));
+  }
+  return n;
+}
+
+std::vector<std::string> curves_default_parameters(const Preset& base) {
+  std::vector<std::string> n = {"a_0", "phi_j", "a_inf", "phi_c", "tau_star"};
+  for (std::size_t i = 0; i < base.steady.eta_B_terms.size(); ++i) {
+    n.push_back(fmt::format("eta_B[{}].phi_i", i));
+    n.push_back(fmt::format("eta_B[{}].alpha", i));
+  }
+  return n;
+}
+
+void validate_curves_data(const std::vector<double>& phi, const std::vector<double>& shear_rate,
+                          const std::vector<double>& shear_stress, const Preset& base,
+                          const CurvesFitOptions& options) {
+  const std::string& w = options.where;
+  if (phi.size() != shear_rate.size() || phi.size() != shear_stress.size()) {
+    throw InputError(fmt::format("{}: columns phi, shear_rate, shear_stress have {}, {}, {} values: must be equal", w,
+                                 phi.size(), shear_rate.size(), shear_stress.size()));
+  }
+  const std::size_t p = options.parameters.empty() ? curves_default_parameters(base).size() : options.parameters.size();
+  if (phi.size() < p + 1) {
+    throw InputError(
+        fmt::format("{}: {} points for {} fitted parameters: need at least p + 1 = {}", w, phi.size(), p, p + 1));
+  }
+  for (std::size_t k = 0; k < phi.size(); ++k) {
+    if (!(std::isfinite(phi[k]) && phi[k] > 0.0 && phi[k] < 1.0)) {
+      throw InputError(
+          fmt::format("{}: row {}: column 'phi' = {}: must be a finite number in (0, 1)", w, k + 1, phi[k]));
+    }
+    if (!(std::isfinite(shear_rate[k]) && shear_rate[k] > 0.0)) {
+      throw InputError(fmt::format("{}: row {}: column 'shear_rate' = {}: must be a positive finite number [1/s]", w,
+                                   k + 1, shear_rate[k]));
+    }
+    if (!(std::isfinite(shear_stress[k]) && shear_stress[k] > 0.0)) {
+      throw InputError(fmt::format("{}: row {}: column 'shear_stress' = {}: must be a positive finite number [Pa]", w,
+                                   k + 1, shear_stress[k]));
+    }
+  }
+}
+
+CurvesFitResult fit_curves(const std::vector<double>& phi, const std::vector<double>& shear_rate,
+                           const std::vector<double>& shear_stress, const Preset& base,
+                           const CurvesFitOptions& options) {
+  const std::string& w = options.where;
+  validate_curves_data(phi, shear_rate, shear_stress, base, options);
+  const std::vector<std::string> names =
+      options.parameters.empty() ? curves_default_parameters(base) : options.parameters;
+  std::vector<Param> params;
+  for (const auto& n : names) {
+    for (const auto& q : params) {
+      if (q.name == n) throw InputError(fmt::format("{}: parameter '{}' is listed twice", w, n));
+    }
+    params.push_back(parse_param(n, base, w));
+  }
+  auto fitted = [&](Param::Field f) {
+    return std::any_of(params.begin(), params.end(), [f](const Param& q) { return q.field == f; });
+  };
+  const double max_phi = *std::max_element(phi.begin(), phi.end());
+  if (!fitted(Param::phi_j)) {
+    for (std::size_t k = 0; k < phi.size(); ++k) {
+      if (!(phi[k] < base.steady.phi_j)) {
+        throw InputError(fmt::format(
+            "{}: row {}: column 'phi' = {}: must be below phi_j = {} of the base set (phi_j is not fitted; at "
+            "phi >= phi_j there is no steady flow)",
+            w, k + 1, phi[k], base.steady.phi_j));
+      }
+    }
+  }
+
+  // Bounds: the model's rules, then the caller's.
+  for (Param& q : params) {
+    switch (q.field) {
+      case Param::phi_j:
+        q.lower = std::max(max_phi, fitted(Param::phi_c) ? 0.0 : base.steady.phi_c) + kStrict;
+        q.upper = 1.0 - kStrict;
+        break;
+      case Param::phi_c:
+        q.lower = kStrict;
+        q.upper = (fitted(Param::phi_j) ? 1.0 : base.steady.phi_j) - kStrict;
+        break;
+      case Param::Delta:
+        q.lower = 0.0;
+        q.upper = 1.0;
+        break;
+      case Param::alpha:
+        q.lower = 0.0;
+        q.upper = kAlphaMax;
+        break;
+      default:  // positive scales, fitted through their logarithm
+        q.lower = 0.0;
+        q.upper = kInf;
+    }
+  }
+  for (const ParameterBounds& b : options.bounds) {
+    auto it = std::find_if(params.begin(), params.end(), [&](const Param& q) { return q.name == b.name; });
+    if (it == params.end()) {
+      throw InputError(
+          fmt::format("{}: bounds for '{}', which is not fitted (fitted: {})", w, b.name, fmt::join(names, ", ")));
+    }
+    if (!(b.lower < b.upper) || std::isnan(b.lower) || std::isnan(b.upper)) {
+      throw InputError(fmt::format("{}: bounds of '{}' = ({}, {}): the lower bound must be below the upper", w, b.name,
+                                   b.lower, b.upper));
+    }
+    it->lower = std::max(it->lower, b.lower);
+    it->upper = std::min(it->upper, b.upper);
+    if (!(it->lower < it->upper)) {
+      throw InputError(fmt::format("{}: bounds of '{}' = ({}, {}) leave no admissible value with the model's rules", w,
+                                   b.name, b.lower, b.upper));
+    }
+  }
+
+  // Start: the base set's values, moved into the bounds (phi_j a little above the densest point).
+  const std::size_t P = params.size();
+  std::vector<double> x(P);
+  SteadyParams start = base.steady;
+  for (std::size_t i = 0; i < P; ++i) {
+    Param& q = params[i];
+    double v = slot(start, q);
+    if (!(v > q.lower)) v = q.field == Param::phi_j ? std::min(q.lower + 0.01, 0.5 * (q.lower + q.upper)) : q.lower;
+    if (!(v < q.upper)) v = q.upper;
+    if (q.log && !(v > 0.0)) v = 1.0;
+    if (q.log && q.field == Param::phi_i && v <= 0.0) v = 1.0;
+    x[i] = q.log ? std::log(v) : v;
+  }
+
+  std::vector<Group> groups;
+  std::vector<double> ln_rate(phi.size()), ln_stress(phi.size());
+  for (std::size_t k = 0; k < phi.size(); ++k) {
+    ln_rate[k] = std::log(shear_rate[k]);
+    ln_stress[k] = std::log(shear_stress[k]);
+    auto it = std::find_if(groups.begin(), groups.end(), [&](const Group& g) { return g.phi == phi[k]; });
+    if (it == groups.end()) {
+      groups.push_back({phi[k], {}});
+      it = groups.end() - 1;
+    }
+    it->rows.push_back(static_cast<int>(k));
+  }
+  const int n = static_cast<int>(phi.size());
+  auto* functor = new CurvesCost{&params, base.steady, &groups, &ln_rate, &ln_stress, options.residual, max_phi};
+  const CurvesCost& cost_fn = *functor;
+  ceres::Problem problem;  // owns the functor from here on
+  auto* cost = new ceres::DynamicNumericDiffCostFunction<CurvesCost, ceres::CENTRAL>(functor);
+  cost->AddParameterBlock(static_cast<int>(P));
+  cost->SetNumResiduals(n);
+  problem.AddResidualBlock(cost, nullptr, x.data());
+
+  std::vector<double> r(phi.size()), model(phi.size());
+  int failed = -1;
+  if (!cost_fn.evaluate(x.data(), r.data(), model.data(), &failed)) {
+    if (failed < 0) {
+      throw InputError(
+          fmt::format("{}: the starting parameters (the base set {}, moved into the bounds) break a "
+                      "rule of the model (phi_c < phi_j, phi_j > every data phi = {} ...)",
+                      w, base.name, max_phi));
+    }
+    const auto f = static_cast<std::size_t>(failed);
+    throw InputError(fmt::format(
+        "{}: row {} (phi = {}, shear_rate = {} 1/s, shear_stress = {} Pa): the starting parameters (base set {}) "
+        "have no steady state at this {}; start from a base set closer to the data{}",
+        w, failed + 1, phi[f], shear_rate[f], shear_stress[f], base.name,
+        options.residual == CurvesResidual::rate ? "stress" : "rate (above the fastest steady shear, e.g. DST)",
+        options.residual == CurvesResidual::stress ? " or use the residual 'rate' (stress-controlled matching)" : ""));
+  }
+
+  for (std::size_t i = 0; i < P; ++i) {
+    const Param& q = params[i];
+    const double lo = q.log ? (q.lower > 0.0 ? std::log(q.lower) : -kInf) : q.lower;
+    const double hi = q.log ? (std::isfinite(q.upper) ? std::log(q.upper) : kInf) : q.upper;
+    if (std::isfinite(lo)) problem.SetParameterLowerBound(x.data(), static_cast<int>(i), lo);
+    if (std::isfinite(hi)) problem.SetParameterUpperBound(x.data(), static_cast<int>(i), hi);
+  }
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  so.max_num_iterations = options.max_iterations;
+  so.function_tolerance = 1e-10;
+  so.gradient_tolerance = 1e-12;
+  so.parameter_tolerance = 1e-10;
+  so.logging_type = ceres::SILENT;
+  so.minimizer_progress_to_stdout = false;
+  so.num_threads = 1;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+  if (summary.termination_type != ceres::CONVERGENCE || !std::isfinite(summary.final_cost)) {
+    throw NumericalError(fmt::format(
+        "{}: the curves fit did not converge after {} iterations ({}: {}); start from a base set closer to the "
+        "data or fit fewer parameters",
+        w, summary.iterations.size(), ceres::TerminationTypeToString(summary.termination_type), summary.message));
+  }
+
+  CurvesFitResult res;
+  res.n = n;
+  res.p = static_cast<int>(P);
+  res.cost = summary.final_cost;
+  res.iterations = static_cast<int>(summary.iterations.size());
+  if (!cost_fn.evaluate(x.data(), r.data(), model.data(), nullptr)) {
+    throw NumericalError(
+        fmt::format("{}: the curves fit ended on parameters without a steady state for every point", w));
+  }
+  res.residuals = r;
+  res.model = model;
+  double ss = 0.0;
+  for (double v : r) ss += v * v;
+  res.rms = std::sqrt(ss / n);
+
+  // Jacobian at the solution (internal parameters), scaled to unit columns for the rank test.
+  double cost_at = 0.0;
+  ceres::CRSMatrix crs;
+  problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost_at, nullptr, nullptr, &crs);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(P));
+  for (int row = 0; row < crs.num_rows; ++row) {
+    for (int k = crs.rows[static_cast<std::size_t>(row)]; k < crs.rows[static_cast<std::size_t>(row) + 1]; ++k) {
+      J(row, crs.cols[static_cast<std::size_t>(k)]) = crs.values[static_cast<std::size_t>(k)];
+    }
+  }
+  Eigen::VectorXd scale(static_cast<Eigen::Index>(P));
+  std::vector<std::string> flat;
+  for (std::size_t i = 0; i < P; ++i) {
+    const double norm = J.col(static_cast<Eigen::Index>(i)).norm();
+    if (!(norm > 0.0)) flat.push_back(params[i].name);
+    scale(static_cast<Eigen::Index>(i)) = norm > 0.0 ? 1.0 / norm : 1.0;
+  }
+  const std::string hint =
+      "fix it (leave it out of the fitted parameters, keeping the base value) or add data that depend on it (e.g. "
+      "points above phi_c and above tau_star for phi_c, a_inf and eta_B; low-stress points for a_0 and phi_j)";
+  if (!flat.empty()) {
+    throw InputError(fmt::format("{}: the data do not determine {} (the residuals do not change with {}); {}", w,
+                                 fmt::join(flat, ", "), flat.size() == 1 ? "it" : "them", hint));
+  }
+  const Eigen::MatrixXd Js = J * scale.asDiagonal();
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(Js, Eigen::ComputeThinV);
+  const Eigen::VectorXd sv = svd.singularValues();
+  const auto last = static_cast<Eigen::Index>(P) - 1;
+  if (!(sv(last) > kCondition * sv(0))) {
+    const Eigen::VectorXd v = svd.matrixV().col(last);
+    std::vector<std::string> involved;
+    for (std::size_t i = 0; i < P; ++i) {
+      if (std::fabs(v(static_cast<Eigen::Index>(i))) > 0.25) involved.push_back(params[i].name);
+    }
+    throw InputError(fmt::format(
+        "{}: the data do not determine {} (the Jacobian is rank-deficient: a combination of {} leaves every "
+        "residual unchanged; condition {:.2g}); {}",
+        w, fmt::join(involved, ", "), involved.size() == 1 ? "this parameter" : "these parameters", sv(0) / sv(last),
+        hint));
+  }
+  // Covariance of the internal parameters: D V S^-2 V^T D s^2, then to natural units.
+  const double s2 = n > res.p ? 2.0 * res.cost / (n - res.p) : 0.0;
+  const Eigen::MatrixXd V = svd.matrixV();
+  const Eigen::VectorXd inv_s2 = sv.array().square().inverse();
+  Eigen::MatrixXd cov = scale.asDiagonal() * V * inv_s2.asDiagonal() * V.transpose() * scale.asDiagonal() * s2;
+  Eigen::VectorXd dq(static_cast<Eigen::Index>(P));
+  res.fitted = base;
+  for (std::size_t i = 0; i < P; ++i) {
+    const double value = params[i].log ? std::exp(x[i]) : x[i];
+    dq(static_cast<Eigen::Index>(i)) = params[i].log ? value : 1.0;
+    slot(res.fitted.steady, params[i]) = value;
+  }
+  // Determined, but so loosely that the value means nothing: a 1-sigma range wider than a factor
+  // of 1000 for the positive scales, 0.1 for a volume fraction, 10 for an exponent, 1 for Delta.
+  std::vector<std::string> loose;
+  for (std::size_t i = 0; i < P; ++i) {
+    const double se = std::sqrt(cov(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)));
+    const Param& q = params[i];
+    const double limit = q.log                     ? std::log(1000.0)
+                         : q.field == Param::alpha ? 10.0
+                         : q.field == Param::Delta ? 1.0
+                                                   : 0.1;
+    if (!(se <= limit)) {
+      loose.push_back(q.log ? fmt::format("{} (1 sigma: a factor {:.3g})", q.name, std::exp(std::min(se, 700.0)))
+                            : fmt::format("{} (1 sigma: +- {:.3g})", q.name, se));
+    }
+  }
+  if (!loose.empty()) {
+    throw InputError(fmt::format("{}: the data do not determine {}; {}", w, fmt::join(loose, ", "), hint));
+  }
+  cov = dq.asDiagonal() * cov * dq.asDiagonal();
+  res.covariance.resize(P * P);
+  res.correlation.resize(P * P);
+  for (std::size_t i = 0; i < P; ++i) {
+    const auto ii = static_cast<Eigen::Index>(i);
+    res.parameters.push_back({params[i].name, slot(res.fitted.steady, params[i]), std::sqrt(cov(ii, ii))});
+    for (std::size_t j = 0; j < P; ++j) {
+      const auto jj = static_cast<Eigen::Index>(j);
+      res.covariance[i * P + j] = cov(ii, jj);
+      res.correlation[i * P + j] = cov(ii, jj) / std::sqrt(cov(ii, ii) * cov(jj, jj));
+    }
+  }
+  try {
+    validate(res.fitted, w);
+  } catch (const InputError& e) {
+    throw NumericalError(fmt::format("the fitted parameters break a rule: {}", e.what()));
+  }
+  return res;
+}
+
+}  // namespace oobleck::rheology
