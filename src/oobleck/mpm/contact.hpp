@@ -18,9 +18,10 @@
 //   a gap leaves it below 1, and at a corner next to empty space it is well below 1. The pure
 //   "both have mass" rule of model.md §8 (θ = 0) acts up to a cell early at every edge (see
 //   docs/contact.md for what it does to a sliding block). The outward normal of the solid is
-//   n = ∇m_b/|∇m_b| with ∇m_b,i = Σ_p m_p ∇N_i(x_p) (at a node outside the body every ∇N_i(x_p)
-//   points from the body's points towards the node: outward). Only phases that approach the
-//   solid, (v_k − v_b)·n < 0, are touched:
+//   n = ∇m_b/|∇m_b| with ∇m_b,i = Σ_p m'_p ∇N_i(x_p), m'_p = m_p, or for a free rigid body the
+//   point's mass in the grid's plane (normal_weight: m_p/r_p in axisymmetric mode). At a
+//   node outside the body every ∇N_i(x_p) points from the body's points towards the node:
+//   outward. Only phases that approach the solid, (v_k − v_b)·n < 0, are touched:
 //     both grains and fluid approach: the three share the mass-weighted normal velocity
 //       v_n* = (m_b v_b·n + m_s v_s·n + m_f v_f·n)/(m_b + m_s + m_f)        (three-body)
 //     one phase k approaches:  v_n* = (m_b v_b·n + m_k v_k·n)/(m_b + m_k)   (two-body)
@@ -244,18 +245,39 @@ void predict_rigid(RigidMotion<G>& rm, const Body<G>& body, GridField<G>& field,
   }
 }
 
-/// Nodal mass gradient ∇m_b,i = Σ_p m_p ∇N_ip and nodal volume Σ_p N_ip V_p of a body (its
-/// shape cache of the step); `grad` may be null (volume only).
+/// The weight of point p in a contact normal's mass gradient. `plane` (the normals of a free
+/// rigid body's contact, see the Solver): the point's mass in the grid's plane, m_p in plane
+/// strain (and 3D); in axisymmetric mode (masses per radian, m_p = ρ_p A_p r_p, model.md §7)
+/// m_p/r_p = ρ_p A_p, the mass of its cross-section in the (r, z) plane. Σ_p ρ_p A_p ∇N_ip is the
+/// gradient of the smoothed density, zero inside a uniform body: the normal is a property of the
+/// body's shape. The per-radian masses add the gradient of the factor r,
+/// Σ_p m_p ∇N_ip ≈ ρ ∫ r ∇N_i dA = −ρ ∫ N_i dA ê_r (−ρ h² ê_r per node) inside a uniform body;
+/// against a surface's own gradient, ~ρ r_i h × (the node's uncovered share of its support), it
+/// tilts the normal of a face perpendicular to the axis towards ê_r by ~h/r_i. Measured on the
+/// floating rod (docs/contact.md, R = 4 h, h = 1 mm): combined normal (0.998, −0.062) at the node
+/// 0.76 h below the bottom face at r = 2 mm; that node then held the fluid radially only, and the
+/// rod floated 0.51 mm deep. Without `plane` (prescribed and deformable bodies): m_p (with
+/// m_p/r_p the prescribed intruder's coarse S3 scene test fails, docs/contact.md).
+template <class G>
+double normal_weight(const Body<G>& body, std::int64_t p, bool plane) {
+  if constexpr (G::has_hoop_terms)
+    return plane ? body.mass_kg[p] / G::measure(body.x_m[p], 1.0) : body.mass_kg[p];
+  else
+    return body.mass_kg[p];
+}
+
+/// Nodal mass gradient ∇m_b,i = Σ_p m'_p ∇N_ip (m'_p = normal_weight) and nodal volume
+/// Σ_p N_ip V_p of a body (its shape cache of the step); `grad` may be null (volume only).
 template <class G, int K>
 void scatter_mass_gradient_and_volume(const Body<G>& body, const ShapeCache<G::dim>& cache,
-                                      std::vector<Vec<G::dim>>* grad, std::vector<double>& volume) {
+                                      std::vector<Vec<G::dim>>* grad, std::vector<double>& volume, bool plane) {
   if (grad)
     for (auto& g : *grad) g.setZero();
   std::fill(volume.begin(), volume.end(), 0.0);
   constexpr int D = G::dim, S = support_of<D>(K);
   const std::int64_t np = body.size();
   for (std::int64_t p = 0; p < np; ++p) {
-    const double m = body.mass_kg[p], V = body.volume_m3[p];
+    const double m = normal_weight(body, p, plane), V = body.volume_m3[p];
     for_each_node<D, S>(cache.template stencil<S>(p), [&](int i, double w, const double* g, const double*) {
       if (grad) (*grad)[i] += m * Eigen::Map<const Vec<D>>(g);
       volume[i] += w * V;
@@ -263,21 +285,23 @@ void scatter_mass_gradient_and_volume(const Body<G>& body, const ShapeCache<G::d
   }
 }
 
-/// Nodal mass gradient ∇m_i = Σ_p m_p ∇N_ip of the points of `body` that lie within `half` of
-/// `centre` along every axis (minimum image on periodic axes); the others are skipped. Used for
-/// the mixture's gradient, which contact reads only at nodes where a solid has mass: with the box
-/// around the solids' points grown by two kernel widths, every point that reaches such a node is
-/// inside, in the same order, so those nodes get exactly the full scatter's values.
+/// Nodal mass gradient ∇m_i = Σ_p m'_p ∇N_ip (m'_p = normal_weight) of the points of `body` that
+/// lie within `half` of `centre` along every axis (minimum image on periodic axes); the others are
+/// skipped. Used for the mixture's gradient, which contact reads only at nodes where a solid has
+/// mass: with the box around the solids' points grown by two kernel widths, every point that
+/// reaches such a node is inside, in the same order, so those nodes get exactly the full
+/// scatter's values.
 template <class G, int K>
 void scatter_mass_gradient_near(const Body<G>& body, const ShapeCache<G::dim>& cache, const Grid<G::dim>& grid,
-                                const Vec<G::dim>& centre, const Vec<G::dim>& half, std::vector<Vec<G::dim>>& grad) {
+                                const Vec<G::dim>& centre, const Vec<G::dim>& half, std::vector<Vec<G::dim>>& grad,
+                                bool plane) {
   constexpr int D = G::dim, S = support_of<D>(K);
   for (auto& g : grad) g.setZero();
   const std::int64_t np = body.size();
   for (std::int64_t p = 0; p < np; ++p) {
     const Vec<D> d = periodic_difference<D>(grid, body.x_m[p], centre);
     if ((d.cwiseAbs().array() > half.array()).any()) continue;
-    const double m = body.mass_kg[p];
+    const double m = normal_weight(body, p, plane);
     for_each_node<D, S>(cache.template stencil<S>(p), [&](int i, double, const double* g, const double*) {
       grad[i] += m * Eigen::Map<const Vec<D>>(g);
     });

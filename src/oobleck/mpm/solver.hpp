@@ -498,7 +498,16 @@ class Solver {
     if (contacts_.empty()) return;
     GridField<G>* fluid = fluid_ >= 0 ? &fields_[fluid_] : nullptr;
     bool combined = false;
-    for (const auto& c : contacts_) combined = combined || c.combined_normal;
+    // Normals of free rigid bodies from the masses in the grid's plane (contact.hpp, normal_weight);
+    // the mixture's gradient is shared by the pairs: in the plane when every pair with the
+    // combined normal has a free rigid body.
+    bool plane_mix = false, other = false;
+    for (const auto& c : contacts_) {
+      combined = combined || c.combined_normal;
+      if (!c.combined_normal) continue;
+      (rigid_[c.solid].kind == BodyMotion::FreeRigid ? plane_mix : other) = true;
+    }
+    plane_mix = plane_mix && !other;
     const int mix = grains_ >= 0 ? grains_ : fluid_;
     mixture_volume_scattered_ = false;
     if (mix >= 0 && fluid && combined) {
@@ -520,17 +529,19 @@ class Solver {
         const double margin = 2.0 * kernel_support(opt_.shape) * grid_.h_m;
         const Vec<D> centre = ref + 0.5 * (lo + hi);
         const Vec<D> half = 0.5 * (hi - lo) + Vec<D>::Constant(margin);
-        scatter_mass_gradient_near<G, K>(*bodies_[mix], caches_[mix], grid_, centre, half, mixture_gradient_);
+        scatter_mass_gradient_near<G, K>(*bodies_[mix], caches_[mix], grid_, centre, half, mixture_gradient_,
+                                         plane_mix);
       } else {
         for (auto& g : mixture_gradient_) g.setZero();
       }
     } else if (mix >= 0 && (combined || !fluid)) {  // mixture mass gradient and/or volume
       scatter_mass_gradient_and_volume<G, K>(*bodies_[mix], caches_[mix], combined ? &mixture_gradient_ : nullptr,
-                                             mixture_volume_);
+                                             mixture_volume_, plane_mix);
       mixture_volume_scattered_ = true;
     }
     for (auto& c : contacts_)
-      scatter_mass_gradient_and_volume<G, K>(*bodies_[c.solid], caches_[c.solid], &c.mass_gradient, c.volume_m3);
+      scatter_mass_gradient_and_volume<G, K>(*bodies_[c.solid], caches_[c.solid], &c.mass_gradient, c.volume_m3,
+                                             rigid_[c.solid].kind == BodyMotion::FreeRigid);
   }
 
   /// Contact, part 3 (after the grid pass): every pair's impulses (model.md §8, contact.hpp),
