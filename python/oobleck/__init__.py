@@ -225,7 +225,7 @@ def flow_curve(params, phi, points: int = 200, *, as_frame: bool = True):
     granular_pressure [Pa], granular_shear_stress [Pa], viscosity [Pa s], eta_r [-],
     shear_rate_dst [1/s] (E14 at that phi, NaN where DST does not apply).
     as_frame=False returns the same columns as a dict {column: 1-D numpy array} (the same numbers,
-    without pandas: about 6x faster for one 200-point curve, see docs/python.md).
+    without pandas: about 1.5x faster for one 200-point curve, see docs/python.md).
     """
     global _flow_curve_index
     p = params if type(params) is Params else _params(params)
