@@ -3,6 +3,8 @@
 //   --kind low : (a_0, phi_j) of E12 to minimum viscosities      (columns phi, viscosity | relative_viscosity)
 //   --kind high: (a_inf, phi_c) of E13 to plateau viscosities     (same columns)
 //   --kind dst : eta_B terms (phi_i, alpha_i) of E8 via E14        (columns phi, shear_rate_dst)
+//   --kind curves: a joint fit to whole flow curves (rheology/fit_curves.hpp; columns phi,
+//                  shear_rate, shear_stress)
 // Writes a complete parameter file (the base set with the fitted values replaced, standard errors
 // as comments) that loads with --params in every other command.
 #include <algorithm>
@@ -173,9 +175,66 @@ std::string plot_fit(const rheology::FitResult& r, const Data& d, const std::str
 
 /// `--kind curves`: the joint fit of whole flow curves (rheology/fit_curves.hpp).
 struct CurvesOpts {
-  std::string data, out, parameters, residual;
+  std::string data, out, parameters, residual, png;
   bool json = false;
 };
+
+/// `--kind curves --plot`: the data (with the model's value and the residual per point) and the
+/// fitted flow curves at each data phi (every branch, 300 points, cut to the data's stress range
+/// widened by 3x) for tools/plot_fit.py, then the plot, written to a temporary PNG beside `png`;
+/// returns the temporary's path.
+std::string plot_curves_fit(const rheology::CurvesFitResult& r, const io::CsvTable& t,
+                            rheology::CurvesResidual residual, const std::string& title, const std::string& png) {
+  const fs::path dir = fs::temp_directory_path();
+  const std::string stem = fmt::format("oobleck-fit-{}", ::getpid());
+  const std::string data_csv = (dir / (stem + "-data.csv")).string();
+  const std::string curve_csv = (dir / (stem + "-curve.csv")).string();
+  struct Cleanup {
+    std::vector<std::string> files;
+    ~Cleanup() {
+      std::error_code ec;
+      for (const auto& f : files) fs::remove(f, ec);
+    }
+  } cleanup{{data_csv, curve_csv}};
+
+  const std::vector<double> phi = t.column("phi"), rate = t.column("shear_rate"), stress = t.column("shear_stress");
+  std::string s = "phi,shear_rate,shear_stress,model,residual\n";
+  for (std::size_t k = 0; k < phi.size(); ++k) {
+    s += fmt::format("{},{},{},{},{}\n", num(phi[k]), num(rate[k]), num(stress[k]), num(r.model[k]),
+                     num(r.residuals[k]));
+  }
+  io::write_file_atomically(data_csv, s, "plot data");
+
+  std::vector<double> phis = phi;
+  std::sort(phis.begin(), phis.end());
+  phis.erase(std::unique(phis.begin(), phis.end()), phis.end());
+  std::string c = "phi,shear_rate,shear_stress\n";
+  for (double x : phis) {
+    double lo = INFINITY, hi = 0.0;
+    for (std::size_t k = 0; k < phi.size(); ++k) {
+      if (phi[k] == x) {
+        lo = std::min(lo, stress[k]);
+        hi = std::max(hi, stress[k]);
+      }
+    }
+    for (const auto& pt : rheology::flow_curve(r.fitted.steady, x, 300)) {
+      if (pt.shear_stress > lo / 3.0 && pt.shear_stress < 3.0 * hi && std::isfinite(pt.shear_rate))
+        c += fmt::format("{},{},{}\n", num(x), num(pt.shear_rate), num(pt.shear_stress));
+    }
+  }
+  io::write_file_atomically(curve_csv, c, "plot curve");
+
+  const std::string tmp = png + ".tmp.png";
+  try {
+    run_tool("plot_fit.py", {data_csv, curve_csv, "--kind", "curves", "--residual", rheology::to_string(residual),
+                             "--title", title, tmp});
+  } catch (...) {
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw;
+  }
+  return tmp;
+}
 
 void fit_curves_command(const CurvesOpts& o, rheology::Preset preset, const std::string& note) {
   const io::CsvTable t = io::read_csv(o.data);
@@ -202,6 +261,7 @@ void fit_curves_command(const CurvesOpts& o, rheology::Preset preset, const std:
     }
   }
   io::check_writable(o.out, "--out");
+  if (!o.png.empty()) io::check_writable(o.png, "--plot");
   const auto r =
       rheology::fit_curves(t.column("phi"), t.column("shear_rate"), t.column("shear_stress"), preset, options);
   rheology::Preset fitted = r.fitted;
@@ -220,7 +280,22 @@ void fit_curves_command(const CurvesOpts& o, rheology::Preset preset, const std:
     h += fmt::format("#   {} = {:.8g} +- {} {}\n", p.name, p.value, fmt_se(p.std_error), unit_of(p.name));
   }
   h += fmt::format("# n = {} points, p = {} parameters, rms log residual = {:.4g}\n\n", r.n, r.p, r.rms);
-  io::write_file_atomically(o.out, h + rheology::to_toml(fitted), "--out");
+  std::string tmp_png;
+  if (!o.png.empty()) {
+    tmp_png = plot_curves_fit(
+        r, t, options.residual,
+        fmt::format("{}: fit --kind curves (base {})", fs::path(o.data).filename().string(), preset.name), o.png);
+  }
+  try {
+    io::write_file_atomically(o.out, h + rheology::to_toml(fitted), "--out");
+  } catch (...) {
+    if (!tmp_png.empty()) {
+      std::error_code ec;
+      fs::remove(tmp_png, ec);
+    }
+    throw;
+  }
+  if (!tmp_png.empty()) fs::rename(tmp_png, o.png);
   if (o.json) {
     nlohmann::json params = nlohmann::json::object();
     for (const auto& p : r.parameters) params[p.name] = {{"value", p.value}, {"std_error", p.std_error}};
@@ -250,6 +325,7 @@ void fit_curves_command(const CurvesOpts& o, rheology::Preset preset, const std:
   fmt::print("rms log residual = {:.4g} (n = {}, residual: ln {})\n", r.rms, r.n,
              rheology::to_string(options.residual));
   fmt::print("wrote {}\n", o.out);
+  if (!o.png.empty()) fmt::print("wrote {}\n", o.png);
 }
 
 }  // namespace
@@ -274,7 +350,8 @@ void add_fit_command(CLI::App& rheology) {
       ->required();
   o->params.add_to(cmd);
   cmd->add_option("--out", o->out, "fitted parameter file (TOML) to write")->required();
-  cmd->add_option("--plot", o->png, "also plot data and fitted curve to this PNG");
+  cmd->add_option("--plot", o->png,
+                  "also plot data and fitted curve (curves: the flow curves and the residuals) to this PNG");
   auto* terms = cmd->add_option("--terms", o->terms,
                                 "dst only: number of eta_B terms to fit (default: as many as the base set has, or 1)");
   cmd->add_flag("--json", o->json,
@@ -286,9 +363,15 @@ void add_fit_command(CLI::App& rheology) {
                                    "curves only: rate (ln shear rate at the measured stress) or stress (ln shear "
                                    "stress at the measured rate)");
   cmd->callback([o, terms, parameters, residual] {
+    if (o->kind != "low" && o->kind != "high" && o->kind != "dst" && o->kind != "curves") {
+      throw InputError(
+          fmt::format("--kind = '{}': must be one of low (a_0, phi_j from minimum viscosities, E12), high (a_inf, "
+                      "phi_c from plateau viscosities, E13), dst (eta_B terms from DST rates, E14), curves (joint "
+                      "fit to whole flow curves: phi, shear_rate, shear_stress)",
+                      o->kind));
+    }
     if (o->kind == "curves") {
       if (terms->count() > 0) throw InputError(fmt::format("--terms = {}: only for --kind dst (not curves)", o->terms));
-      if (!o->png.empty()) throw InputError("--plot: not for --kind curves (use FitResult.plot() in Python)");
       const bool default_base = o->params.preset.empty() && o->params.params.empty();
       std::string note;
       if (default_base) {
@@ -296,7 +379,8 @@ void add_fit_command(CLI::App& rheology) {
             fmt::format("no --preset or --params given: using the {} preset as the base parameter set", kDefaultPreset);
         fmt::print(o->json ? stderr : stdout, "{}\n", note);
       }
-      fit_curves_command({o->data, o->out, o->parameters, o->residual, o->json}, o->params.load(kDefaultPreset), note);
+      fit_curves_command({o->data, o->out, o->parameters, o->residual, o->png, o->json}, o->params.load(kDefaultPreset),
+                         note);
       return;
     }
     for (auto* opt : {parameters, residual}) {

@@ -1,5 +1,11 @@
 // Benchmark (not a test): steady flow-curve generation (E11 sweep) per preset, and the
 // xi_dot_eps > 0 variant that needs a scalar root per point. Reports points per second.
+// BM_FlowCurveColumns does, in C++, the work of the Python module's flow_curve (python/src/
+// module.cpp) besides the sweep: the DST rate (E14) and the 9 columns filled into one block; it
+// splits the Python overhead of bench/flow_curve_python.py into this work and the Python boundary.
+#include <optional>
+#include <vector>
+
 #include <benchmark/benchmark.h>
 
 #include "oobleck/rheology/flow_curve.hpp"
@@ -19,9 +25,37 @@ static void BM_FlowCurve(benchmark::State& state, const char* preset, double phi
       benchmark::Counter(static_cast<double>(n) * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 
+static void BM_FlowCurveColumns(benchmark::State& state, const char* preset, double phi) {
+  const auto p = rheology::load_preset(preset);
+  const int n = static_cast<int>(state.range(0));
+  const auto r = static_cast<std::size_t>(n);
+  for (auto _ : state) {
+    std::vector<double> c(9 * r);  // the module allocates a fresh (9, rows) array per call
+    const double dst = rheology::shear_rate_dst(p.steady, phi).value_or(-1.0);
+    std::size_t i = 0;
+    for (const auto& pt : rheology::flow_curve(p.steady, phi, n)) {
+      c[i] = pt.phi;
+      c[r + i] = pt.f;
+      c[2 * r + i] = pt.shear_rate;
+      c[3 * r + i] = pt.shear_stress;
+      c[4 * r + i] = pt.granular_pressure;
+      c[5 * r + i] = pt.granular_shear_stress;
+      c[6 * r + i] = pt.viscosity;
+      c[7 * r + i] = pt.eta_r;
+      c[8 * r + i] = dst;
+      ++i;
+    }
+    benchmark::DoNotOptimize(c.data());
+    benchmark::ClobberMemory();
+  }
+  state.counters["points/s"] =
+      benchmark::Counter(static_cast<double>(n) * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+
 BENCHMARK_CAPTURE(BM_FlowCurve, hermes2016_dst, "hermes2016", 0.47, 0.0)->Arg(400)->Arg(200);
 BENCHMARK_CAPTURE(BM_FlowCurve, singh2018b_s_shape, "singh2018b", 0.56, 0.0)->Arg(400);
 BENCHMARK_CAPTURE(BM_FlowCurve, frith1996_cst, "frith1996", 0.50, 0.0)->Arg(400);
 BENCHMARK_CAPTURE(BM_FlowCurve, hermes2016_brownian, "hermes2016", 0.47, 1.0)->Arg(400);
+BENCHMARK_CAPTURE(BM_FlowCurveColumns, hermes2016_dst, "hermes2016", 0.47)->Arg(200);
 
 BENCHMARK_MAIN();

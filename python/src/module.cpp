@@ -60,42 +60,52 @@ void number_property(py::class_<rheology::Preset>& cls, const char* name, Get ge
 
 // ---- rheology ------------------------------------------------------------------------------
 
-py::dict flow_curve(const rheology::Preset& p, const std::vector<double>& phis, int points) {
+/// The flow curves at one or several phi as one (9, rows) C-contiguous array, row k the k-th
+/// column of `rheology flow-curve` (FLOW_CURVE_COLUMNS in Python): one allocation, filled in place
+/// without the GIL (no copy after the sweep); the Python side views its rows as a dict or wraps
+/// it (transposed, no copy) as a DataFrame. `phi` is a float or a sequence of floats.
+py::array_t<double> flow_curve(const rheology::Preset& p, py::handle phi, int points) {
   if (points < 2) throw InputError(fmt::format("points = {}: must be >= 2", points));
-  for (double phi : phis) rheology::validate_phi(p.steady, phi, fmt::format("phi (parameters: {})", p.name));
-  // The columns are filled in place, without the GIL (no copies: the call costs what the sweep does).
-  const auto rows = static_cast<py::ssize_t>(phis.size()) * points;
-  std::vector<py::array_t<double>> cols;
-  double* c[9];
-  for (int k = 0; k < 9; ++k) {
-    cols.emplace_back(rows);
-    c[k] = cols.back().mutable_data();
+  double one = 0.0;
+  std::vector<double> many;
+  const double* phis = &one;
+  std::size_t n = 1;
+  if (PyFloat_Check(phi.ptr())) {
+    one = PyFloat_AS_DOUBLE(phi.ptr());
+  } else {
+    many = phi.cast<std::vector<double>>();
+    phis = many.data();
+    n = many.size();
   }
+  for (std::size_t k = 0; k < n; ++k) {  // the message is formatted only for a bad phi
+    const double v = phis[k];
+    if (!(std::isfinite(v) && v > 0.0 && v < p.steady.phi_j))
+      rheology::validate_phi(p.steady, v, fmt::format("phi (parameters: {})", p.name));
+  }
+  const auto rows = static_cast<py::ssize_t>(n) * points;
+  py::array_t<double> block({py::ssize_t{9}, rows});
+  double* c = block.mutable_data();
   {
     py::gil_scoped_release release;
     std::size_t i = 0;
-    for (double phi : phis) {
-      const auto dst = rheology::shear_rate_dst(p.steady, phi);
-      for (const auto& pt : rheology::flow_curve(p.steady, phi, points)) {
-        c[0][i] = pt.phi;
-        c[1][i] = pt.f;
-        c[2][i] = pt.shear_rate;
-        c[3][i] = pt.shear_stress;
-        c[4][i] = pt.granular_pressure;
-        c[5][i] = pt.granular_shear_stress;
-        c[6][i] = pt.viscosity;
-        c[7][i] = pt.eta_r;
-        c[8][i] = dst ? *dst : kNaN;
+    const auto r = static_cast<std::size_t>(rows);
+    for (std::size_t k = 0; k < n; ++k) {
+      const double dst_rate = rheology::shear_rate_dst(p.steady, phis[k]).value_or(kNaN);
+      for (const auto& pt : rheology::flow_curve(p.steady, phis[k], points)) {
+        c[i] = pt.phi;
+        c[r + i] = pt.f;
+        c[2 * r + i] = pt.shear_rate;
+        c[3 * r + i] = pt.shear_stress;
+        c[4 * r + i] = pt.granular_pressure;
+        c[5 * r + i] = pt.granular_shear_stress;
+        c[6 * r + i] = pt.viscosity;
+        c[7 * r + i] = pt.eta_r;
+        c[8 * r + i] = dst_rate;
         ++i;
       }
     }
   }
-  static const char* names[9] = {
-      "phi",       "f",     "shear_rate",    "shear_stress", "granular_pressure", "granular_shear_stress",
-      "viscosity", "eta_r", "shear_rate_dst"};
-  py::dict d;
-  for (int k = 0; k < 9; ++k) d[names[k]] = cols[static_cast<std::size_t>(k)];
-  return d;
+  return block;
 }
 
 std::optional<double> shear_rate_dst(const rheology::Preset& p, double phi) {

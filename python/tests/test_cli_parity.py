@@ -26,7 +26,13 @@ def assert_same(py, csv):
 def test_flow_curve(cli, tmp_path, preset, phis):
     args = [a for phi in phis for a in ("--phi", phi)]
     cli("rheology", "flow-curve", "--preset", preset, *args, "--points", 200, "--out", tmp_path / "fc.csv")
-    assert_same(oobleck.flow_curve(preset, phis, points=200), read(tmp_path / "fc.csv"))
+    csv = read(tmp_path / "fc.csv")
+    assert_same(oobleck.flow_curve(preset, phis, points=200), csv)
+    assert_same(pd.DataFrame(oobleck.flow_curve(oobleck.load_params(preset), phis, 200, as_frame=False)), csv)
+    for phi in phis:  # one phi as a float (the module's fast path) and as np.float64
+        one = csv[csv["phi"] == phi].reset_index(drop=True)
+        assert_same(oobleck.flow_curve(preset, float(phi)), one)
+        assert_same(pd.DataFrame(oobleck.flow_curve(preset, np.float64(phi), as_frame=False)), one)
 
 
 def test_dst(cli):

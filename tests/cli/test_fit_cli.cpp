@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +19,12 @@
 
 namespace {
 namespace fs = std::filesystem;
+
+std::string fmt(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
 
 /// A fresh, empty folder per test, removed afterwards.
 class FitCli : public ::testing::Test {
@@ -180,6 +187,46 @@ TEST_F(FitCli, DstFitWithPlot) {
   const auto fitted = oobleck::rheology::load_params_file(path("fit.toml"));
   ASSERT_EQ(fitted.steady.eta_B_terms.size(), 1u);
   EXPECT_NEAR(fitted.steady.eta_B_terms[0].alpha, 6.0, 0.1);
+}
+
+TEST_F(FitCli, UnknownKindListsEveryKind) {
+  write("low.csv", low_csv());
+  EXPECT_EQ(run("rheology fit --kind mid --data " + path("low.csv") + " --out " + path("fit.toml")), 2);
+  const std::string err = read("err.txt");
+  for (const char* k : {"'mid'", "low (", "high (", "dst (", "curves ("})
+    EXPECT_NE(err.find(k), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(path("fit.toml")));
+}
+
+TEST_F(FitCli, CurvesFitWithPlot) {
+  if (!fs::exists("/usr/bin/python3")) GTEST_SKIP() << "no /usr/bin/python3 for the plot";
+  // Points of hermes2016's flow curves at 5 phi (every branch), rates with 2 % deterministic scatter.
+  const auto p = oobleck::rheology::load_preset("hermes2016").steady;
+  std::string csv = "phi,shear_rate,shear_stress\n";
+  int k = 0;
+  for (double phi : {0.40, 0.44, 0.46, 0.48, 0.50}) {
+    const auto curve = oobleck::rheology::flow_curve(p, phi, 200);
+    for (std::size_t i = 20; i < curve.size(); i += 18, ++k) {
+      csv += fmt(phi) + "," + fmt(curve[i].shear_rate * (1.0 + 0.02 * std::sin(5.0 * k))) + "," +
+             fmt(curve[i].shear_stress) + "\n";
+    }
+  }
+  write("curves.csv", csv);
+  const std::string args = "rheology fit --kind curves --data " + path("curves.csv") +
+                           " --preset hermes2016 --parameters a_0,phi_j,tau_star --out " + path("fit.toml");
+  ASSERT_EQ(run(args + " --plot " + path("fit.png")), 0) << read("err.txt");
+  EXPECT_NE(read("out.txt").find("wrote " + path("fit.png")), std::string::npos) << read("out.txt");
+  EXPECT_GT(fs::file_size(path("fit.png")), 1000u);
+  const auto fitted = oobleck::rheology::load_params_file(path("fit.toml"));
+  EXPECT_NEAR(fitted.steady.phi_j, p.phi_j, 1e-3);
+  EXPECT_NEAR(fitted.steady.tau_star, p.tau_star, 0.05 * p.tau_star);
+  // An unwritable plot fails before the fit and leaves the parameter file alone.
+  write("fit.toml", "sentinel\n");
+  EXPECT_EQ(run(args + " --plot " + path("missing/fit.png")), 2);
+  EXPECT_EQ(read("fit.toml"), "sentinel\n");
+  for (const auto& e : fs::directory_iterator(dir_)) {  // no temporaries left behind
+    EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << e.path();
+  }
 }
 
 }  // namespace
