@@ -17,7 +17,7 @@
 
 namespace {
 
-constexpr const char* kLoader = "/lib64/ld-linux-x86-64.so.2";
+[[maybe_unused]] constexpr const char* kLoader = "/lib64/ld-linux-x86-64.so.2";
 
 [[maybe_unused]] std::vector<double> last_row(const std::string& csv) {
   std::ifstream in(csv);

@@ -264,6 +264,7 @@ Checkpoint read_checkpoint(const std::string& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw fail("file does not exist");
   if (fs::is_directory(path, ec)) throw fail("is a folder, not a checkpoint file");
+  if (!fs::is_regular_file(path, ec)) throw fail("not a regular file (a device or pipe cannot be a checkpoint)");
   h5::Handle file = h5::open_file_readonly(path);
   if (!file.valid()) {
     throw fail(fmt::format("not a readable HDF5 file (truncated or corrupt?): {}", h5::last_error()));

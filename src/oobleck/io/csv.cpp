@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -46,6 +47,9 @@ std::vector<double> CsvTable::column(const std::string& name) const {
 }
 
 CsvTable read_csv(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+    throw InputError(fmt::format("{}: not a regular file (a directory or device cannot be a data file)", path));
   std::ifstream in(path);
   if (!in) throw InputError(fmt::format("{}: cannot open data file", path));
   CsvTable t;

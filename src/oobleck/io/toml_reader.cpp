@@ -11,6 +11,8 @@ namespace oobleck::io {
 
 toml::table parse_toml_file(const std::string& path) {
   if (!std::filesystem::exists(path)) throw InputError(fmt::format("{}: file not found", path));
+  if (!std::filesystem::is_regular_file(path))
+    throw InputError(fmt::format("{}: not a regular file (a directory or device cannot be a TOML file)", path));
   try {
     return toml::parse_file(path);
   } catch (const toml::parse_error& e) {

@@ -122,7 +122,8 @@ void validate(const Preset& p, const std::string& where) {
 Preset load_preset(const std::string& name) {
   const auto& names = preset_names();
   const std::string path = preset_dir() + "/" + name + ".toml";
-  if (!std::filesystem::exists(path)) {
+  // A name, not a path ("../x", "/dev/zero"): a parameter file is passed as --params FILE.
+  if (name.find('/') != std::string::npos || name.empty() || name[0] == '.' || !std::filesystem::exists(path)) {
     const std::string hint = closest_match(name, names);
     throw InputError(fmt::format("unknown preset '{}'{}; known presets: {} (or pass --params FILE.toml)", name,
                                  hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint),
