@@ -25,7 +25,9 @@ void add_run_command(CLI::App& app) {
   auto o = std::make_shared<Opts>();
   cmd->add_option("scene", o->scene, "scene file (TOML)");
   cmd->add_option("--out", o->out, "run folder (default: out/<scene name>)");
-  cmd->add_option("--set", o->sets, "override a scene key: key.path=value or a short name from [aliases]");
+  cmd->add_option("--set", o->sets,
+                  "override a scene key: key.path=value or a short name from [aliases] (with --restart: [time] "
+                  "keys only)");
   cmd->add_option("--threads", o->threads, "OpenMP threads (default: all cores)");
   cmd->add_option("--checkpoint-every", o->checkpoint_every, "steps between checkpoints (default: the scene's)");
   cmd->add_option("--restart", o->restart, "continue the run in this folder from its last checkpoint");
@@ -40,18 +42,25 @@ void add_run_command(CLI::App& app) {
     ro.stop_after_steps = o->stop_after;
     scene::SceneConfig cfg;
     if (!o->restart.empty()) {
-      if (!o->scene.empty() || !o->sets.empty()) {
-        throw InputError("--restart DIR continues the stored scene of DIR: give no scene file and no --set");
-      }
+      if (!o->scene.empty()) throw InputError("--restart DIR continues the stored scene of DIR: give no scene file");
       if (!std::filesystem::exists(run::checkpoint_path(o->restart))) {
         throw InputError(
             fmt::format("--restart {}: no checkpoint there ({} is missing); run with "
                         "--checkpoint-every N to write one",
                         o->restart, run::checkpoint_path(o->restart)));
       }
-      cfg = scene::load_scene(run::stored_scene_path(o->restart));
+      cfg = scene::load_scene(run::stored_scene_path(o->restart), o->sets);
+      // Only [time] may change: the rest of the scene is the checkpoint's state.
+      for (const auto& spec : o->sets) {
+        const std::string key = scene::override_key(spec, cfg.aliases);
+        if (key.rfind("time.", 0) != 0)
+          throw InputError(fmt::format("--restart {} --set {}: only [time] keys (time.cfl, time.dt, time.duration) "
+                                       "may change on a restart; '{}' is part of the checkpoint's state",
+                                       o->restart, spec, key));
+      }
       ro.out_dir = o->restart;
       ro.restart = true;
+      ro.restart_overrides = o->sets;
     } else {
       if (o->scene.empty()) throw InputError("run: a scene file is required (or --restart DIR)");
       cfg = scene::load_scene(o->scene, o->sets);  // validates everything before any output

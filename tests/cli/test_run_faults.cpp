@@ -212,3 +212,51 @@ TEST(RunFaults, ASecondRunIntoAFolderInUseIsRefused) {
   EXPECT_EQ(read_text(out + "/series.csv").substr(0, series.size()), series);
   EXPECT_TRUE(summary_of(out)["stopped_by"] == "SIGINT");
 }
+
+// A numerical failure mid-run (the rod at time.cfl = 1 on 2.5 mm cells: grains thrown off the
+// grid at step 461) stops with the diagnosis and keeps the last good checkpoint (step 460, one
+// every 20 steps); `--restart DIR --set time.cfl=0.5` continues from it with half the time step,
+// past the failure, and a later plain --restart keeps the new step. Only [time] may change.
+TEST(RunFaults, NumericalFailureKeepsTheLastCheckpointAndARestartWithASmallerStepContinues) {
+  clitest::TempDir d;
+  const std::string out = d / "rod";
+  const std::string rod = std::string(OOBLECK_SOURCE_DIR) + "/scenes/paper/rod_impact.toml";
+  auto r = clitest::run("run " + rod + " --set time.cfl=1.0 --set cell_size=0.0025 --checkpoint-every 20 "
+                        "--stop-after 600 --threads 1 --quiet --out " + out);
+  ASSERT_EQ(r.status, 3) << r.output;
+  EXPECT_NE(r.output.find("numerical failure"), std::string::npos) << r.output;
+  const auto at = r.output.find("at step ");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  const long failed_step = std::stol(r.output.substr(at + 8));
+  const io::Checkpoint before = io::read_checkpoint(out + "/checkpoint.h5");
+  EXPECT_EQ(before.step(), failed_step / 20 * 20) << "the last checkpoint before the failure";
+  const double dt_before = before.real_attribute("dt");
+  const double t_failed = before.time() + static_cast<double>(failed_step - before.step()) * dt_before;
+
+  r = clitest::run("run --restart " + out + " --set grid.cell_size=0.001 --quiet");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("only [time] keys"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("'grid.cell_size'"), std::string::npos) << r.output;
+  EXPECT_EQ(io::read_checkpoint(out + "/checkpoint.h5").step(), before.step()) << "the refusal wrote nothing";
+
+  const long until = before.step() + 140;
+  r = clitest::run("run --restart " + out + " --set time.cfl=0.5 --stop-after " + std::to_string(until) +
+                   " --threads 1 --quiet");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto s = summary_of(out);
+  EXPECT_EQ(s["steps"].get<long>(), until);
+  EXPECT_EQ(s["steps_this_run"].get<long>(), 140);
+  EXPECT_NEAR(s["dt"].get<double>(), 0.5 * dt_before, 1e-15 * dt_before) << "dt = cfl x the stable step";
+  EXPECT_NEAR(s["time"].get<double>(), before.time() + 140 * 0.5 * dt_before, 1e-12);
+  EXPECT_GT(s["time"].get<double>(), t_failed) << "past the moment of the failure";
+  EXPECT_EQ(s["restart_overrides"], nlohmann::json::array({"time.cfl=0.5"}));
+  EXPECT_NE(read_text(out + "/scene.toml").find("cfl = 0.5"), std::string::npos);
+  const io::Checkpoint after = io::read_checkpoint(out + "/checkpoint.h5");
+  EXPECT_EQ(after.step(), until);
+  EXPECT_EQ(after.real_attribute("dt"), s["dt"].get<double>());
+
+  r = clitest::run("run --restart " + out + " --stop-after " + std::to_string(until + 10) + " --threads 1 --quiet");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(summary_of(out)["dt"].get<double>(), after.real_attribute("dt"));
+  EXPECT_FALSE(summary_of(out).contains("restart_overrides"));
+}

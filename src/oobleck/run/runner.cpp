@@ -96,6 +96,9 @@ void SceneRun<G>::start(std::optional<io::FrameWriter>& frames, std::optional<io
   if (opt_.restart) {
     const io::Checkpoint cp = io::read_checkpoint(checkpoint_path(opt_.out_dir));
     restore(cp);
+    // New [time] settings (RunOptions::restart_overrides): a later plain --restart keeps them.
+    if (!opt_.restart_overrides.empty())
+      io::write_file_atomically(stored_scene_path(opt_.out_dir), cfg_.resolved_toml, "scene copy");
     frames.emplace(io::FrameWriter::resume(opt_.out_dir, cp.step()));
     series.emplace(io::SeriesWriter::resume(opt_.out_dir + "/series.csv", series_columns(scene_), cp.time()));
     return;
@@ -160,9 +163,10 @@ void SceneRun<G>::write_checkpoint() {
 
 template <class G>
 void SceneRun<G>::restore(const io::Checkpoint& cp) {
-  if (cp.real_attribute("dt") != scene_.dt_s) {
-    throw InputError(fmt::format("{}: time step {} s differs from the checkpoint's {} s", cp.file(), scene_.dt_s,
-                                 cp.real_attribute("dt")));
+  if (cp.real_attribute("dt") != scene_.dt_s && opt_.restart_overrides.empty()) {
+    throw InputError(fmt::format("{}: time step {} s differs from the checkpoint's {} s (a new time step is "
+                                 "given with --restart DIR --set time.cfl=... or time.dt=...)",
+                                 cp.file(), scene_.dt_s, cp.real_attribute("dt")));
   }
   restore_fields(cp, state_fields());
   solver().set_clock(cp.time(), cp.step());
@@ -171,7 +175,6 @@ void SceneRun<G>::restore(const io::Checkpoint& cp) {
 template <class G>
 nlohmann::json SceneRun<G>::run() {
   make_run_folder();
-  const long total = scene_.total_steps;
   const long every_frame = steps_between(cfg_.output.frame_interval_s, std::numeric_limits<long>::max());
   const long every_series = steps_between(cfg_.output.series_interval_s, 100);
   const long every_cp = opt_.checkpoint_every >= 0 ? opt_.checkpoint_every : cfg_.output.checkpoint_every;
@@ -181,6 +184,15 @@ nlohmann::json SceneRun<G>::run() {
   std::optional<io::FrameWriter> frames;
   std::optional<io::SeriesWriter> series;
   start(frames, series);
+  const long first = static_cast<long>(solver().steps());
+  // A restart with new [time] settings counts its remaining steps from the checkpoint's time, and
+  // the outputs' step intervals from the checkpoint's step.
+  const bool retimed = opt_.restart && !opt_.restart_overrides.empty();
+  const long total =
+      retimed ? first + std::max(0L, static_cast<long>(std::llround((cfg_.time.duration_s - solver().time_s()) /
+                                                                     scene_.dt_s)))
+              : scene_.total_steps;
+  const long base = retimed ? first : 0;
 
   std::int64_t points = 0;
   for (int b = 0; b < solver().body_count(); ++b) points += solver().body(b).size();
@@ -190,7 +202,6 @@ nlohmann::json SceneRun<G>::run() {
   po.label = cfg_.name;
   io::Progress progress(static_cast<std::uint64_t>(total), po);
 
-  const long first = static_cast<long>(solver().steps());
   long last = opt_.stop_after_steps >= 0 ? std::min<long>(opt_.stop_after_steps, total) : total;
   solver().reset_timings();
   const auto t0 = std::chrono::steady_clock::now();
@@ -204,11 +215,12 @@ nlohmann::json SceneRun<G>::run() {
     check_finite();  // before anything of this step is measured or written
     analysis_->after_step();
     const bool final_step = s == total;
-    if (s % every_sample == 0 || final_step) analysis_->sample();
+    const long k = s - base;
+    if (k % every_sample == 0 || final_step) analysis_->sample();
     take_due_snapshots(final_step);
-    if (s % every_frame == 0 || final_step) write_frame(*frames);
-    if (s % every_series == 0 || final_step) series->row(series_row(scene_));
-    if (every_cp > 0 && s % every_cp == 0) write_checkpoint();
+    if (k % every_frame == 0 || final_step) write_frame(*frames);
+    if (k % every_series == 0 || final_step) series->row(series_row(scene_));
+    if (every_cp > 0 && k % every_cp == 0) write_checkpoint();
     progress.update(static_cast<std::uint64_t>(s), solver().time_s());
     if (opt_.on_step && !opt_.on_step(s, total, solver().time_s())) {
       if (s < last) stopped_by = "caller";  // a checkpoint, as for stop_after_steps
@@ -228,6 +240,7 @@ nlohmann::json SceneRun<G>::run() {
 
   nlohmann::json j = summary(last - first, last == total, wall);
   if (!stopped_by.empty()) j["stopped_by"] = stopped_by;
+  if (retimed) j["restart_overrides"] = opt_.restart_overrides;
   io::write_summary(opt_.out_dir, j);
   if (!stopped_by.empty() && stopped_by != "caller") {
     throw Stopped(fmt::format("{}: stopped by {} after step {} (t = {:.6g} s); the checkpoint is written: continue "

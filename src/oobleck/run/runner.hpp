@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -17,6 +18,12 @@ struct RunOptions {
   long checkpoint_every = -1;  ///< steps between checkpoints (-1: the scene's value)
   bool quiet = false;          ///< no progress output
   bool restart = false;        ///< continue from out_dir/checkpoint.h5
+  /// On a restart: the `--set` overrides of [time] the run continues with (a new time step or
+  /// duration, e.g. a smaller time.cfl after a numerical failure). Non-empty: the checkpoint's
+  /// time step may differ, the remaining steps are counted from the checkpoint's time, the
+  /// outputs' step intervals from the checkpoint's step, and the run folder's scene.toml is
+  /// replaced by the new one.
+  std::vector<std::string> restart_overrides;
   long stop_after_steps = -1;  ///< stop (with a checkpoint) after this many steps in total (tests)
   /// Called after every step with (steps done, total steps, simulated time [s]); returning false
   /// stops the run there with a checkpoint, as stop_after_steps does, and summary.json says

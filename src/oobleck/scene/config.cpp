@@ -78,16 +78,25 @@ void set_material_overrides(rheology::Preset& p, io::TomlReader& mat) {
   }
 }
 
-/// Apply one --set override to the parsed document.
-void apply_override(toml::table& root, const std::string& file, const std::string& spec,
-                    const std::map<std::string, std::string>& aliases) {
+}  // namespace
+
+std::string override_key(const std::string& spec, const std::map<std::string, std::string>& aliases) {
   const auto eq = spec.find('=');
   if (eq == std::string::npos || eq == 0) {
     throw InputError(fmt::format("--set '{}': expected key=value", spec));
   }
-  std::string key = spec.substr(0, eq);
-  const std::string value = spec.substr(eq + 1);
-  if (auto it = aliases.find(key); it != aliases.end()) key = it->second;
+  const std::string key = spec.substr(0, eq);
+  const auto it = aliases.find(key);
+  return it != aliases.end() ? it->second : key;
+}
+
+namespace {
+
+/// Apply one --set override to the parsed document.
+void apply_override(toml::table& root, const std::string& file, const std::string& spec,
+                    const std::map<std::string, std::string>& aliases) {
+  const std::string key = override_key(spec, aliases);
+  const std::string value = spec.substr(spec.find('=') + 1);
   // Parse the value as a TOML value; bare words become strings.
   toml::table holder;
   try {

@@ -171,4 +171,8 @@ const std::array<const char*, 6>& face_names();
 /// [aliases] table. Values are parsed as TOML values (numbers, strings in quotes or bare words).
 SceneConfig load_scene(const std::string& path, const std::vector<std::string>& overrides = {});
 
+/// The key path an override `key=value` (or `alias=value`) sets, after the scene's [aliases];
+/// InputError when `spec` has no `=`.
+std::string override_key(const std::string& spec, const std::map<std::string, std::string>& aliases);
+
 }  // namespace oobleck::scene
