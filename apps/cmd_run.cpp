@@ -1,6 +1,5 @@
 // `oobleck run SCENE.toml`: a two-phase MPM run from a scene file (docs/scenes.md), and
 // `oobleck run --restart DIR` to continue from the run's last checkpoint.
-#include <filesystem>
 
 #include <fmt/format.h>
 
@@ -43,24 +42,7 @@ void add_run_command(CLI::App& app) {
     scene::SceneConfig cfg;
     if (!o->restart.empty()) {
       if (!o->scene.empty()) throw InputError("--restart DIR continues the stored scene of DIR: give no scene file");
-      if (!std::filesystem::exists(run::checkpoint_path(o->restart))) {
-        throw InputError(
-            fmt::format("--restart {}: no checkpoint there ({} is missing); run with "
-                        "--checkpoint-every N to write one",
-                        o->restart, run::checkpoint_path(o->restart)));
-      }
-      cfg = scene::load_scene(run::stored_scene_path(o->restart), o->sets);
-      // Only [time] may change: the rest of the scene is the checkpoint's state.
-      for (const auto& spec : o->sets) {
-        const std::string key = scene::override_key(spec, cfg.aliases);
-        if (key.rfind("time.", 0) != 0)
-          throw InputError(fmt::format("--restart {} --set {}: only [time] keys (time.cfl, time.dt, time.duration) "
-                                       "may change on a restart; '{}' is part of the checkpoint's state",
-                                       o->restart, spec, key));
-      }
-      ro.out_dir = o->restart;
-      ro.restart = true;
-      ro.restart_overrides = o->sets;
+      cfg = run::restart_scene(o->restart, o->sets, ro);
     } else {
       if (o->scene.empty()) throw InputError("run: a scene file is required (or --restart DIR)");
       cfg = scene::load_scene(o->scene, o->sets);  // validates everything before any output

@@ -608,15 +608,16 @@ def run(scene=None, out=None, threads=None, set=None, progress=True, *, checkpoi
     --set); progress: a tqdm bar when tqdm is installed, else a text line on stderr every second
     (False: none); checkpoint_every: steps between checkpoints; stop_after: stop (with a
     checkpoint) after this many steps in total; restart=True continues the run in ``out`` from its
-    checkpoint. Ctrl-C (SIGINT) stops after the current step, writes a checkpoint and
+    checkpoint (``set`` may then hold [time] keys only, e.g. {"time.cfl": 0.2} after a numerical
+    failure). Ctrl-C (SIGINT) stops after the current step, writes a checkpoint and
     summary.json (complete: false) and raises KeyboardInterrupt. The GIL is released while the
     run steps.
     """
     if restart:
         if out is None:
             raise InputError("restart=True: out (the run folder to continue) is required")
-        if scene is not None or set:
-            raise InputError("restart=True continues the stored scene of out: give no scene and no set")
+        if scene is not None:
+            raise InputError("restart=True continues the stored scene of out: give no scene")
         scene_path = ""
     else:
         if not isinstance(scene, (str, os.PathLike)):

@@ -458,14 +458,7 @@ py::tuple run_scene(const std::string& scene, const std::vector<std::string>& se
   ro.stop_after_steps = stop_after;
   scene::SceneConfig cfg;
   if (restart) {
-    if (!sets.empty()) throw InputError("restart: continues the stored scene of the run folder: give no set");
-    if (!std::filesystem::exists(run::checkpoint_path(out))) {
-      throw InputError(fmt::format("restart {}: no checkpoint there ({} is missing); run with checkpoint_every=N", out,
-                                   run::checkpoint_path(out)));
-    }
-    cfg = scene::load_scene(run::stored_scene_path(out));
-    ro.out_dir = out;
-    ro.restart = true;
+    cfg = run::restart_scene(out, sets, ro);  // sets: [time] keys only
   } else {
     cfg = scene::load_scene(scene, sets);
     ro.out_dir = out.empty() ? "out/" + cfg.name : out;

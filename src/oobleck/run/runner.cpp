@@ -34,6 +34,26 @@ namespace oobleck::run {
 std::string checkpoint_path(const std::string& run_dir) { return run_dir + "/checkpoint.h5"; }
 std::string stored_scene_path(const std::string& run_dir) { return run_dir + "/scene.toml"; }
 
+scene::SceneConfig restart_scene(const std::string& run_dir, const std::vector<std::string>& overrides,
+                                 RunOptions& options) {
+  if (!std::filesystem::exists(checkpoint_path(run_dir)))
+    throw InputError(fmt::format("restart {}: no checkpoint there ({} is missing); a run writes one every "
+                                 "--checkpoint-every N steps (Python: checkpoint_every=N)",
+                                 run_dir, checkpoint_path(run_dir)));
+  scene::SceneConfig cfg = scene::load_scene(stored_scene_path(run_dir), overrides);
+  for (const auto& spec : overrides) {  // the rest of the scene is the checkpoint's state
+    const std::string key = scene::override_key(spec, cfg.aliases);
+    if (key.rfind("time.", 0) != 0)
+      throw InputError(fmt::format("restart {} with --set {}: only [time] keys (time.cfl, time.dt, time.duration) "
+                                   "may change on a restart; '{}' is part of the checkpoint's state",
+                                   run_dir, spec, key));
+  }
+  options.out_dir = run_dir;
+  options.restart = true;
+  options.restart_overrides = overrides;
+  return cfg;
+}
+
 namespace {
 
 using scene::SceneConfig;

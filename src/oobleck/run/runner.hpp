@@ -34,6 +34,12 @@ struct RunOptions {
 /// Run the scene to its end and return the summary (also written to out_dir/summary.json).
 nlohmann::json run_scene(const scene::SceneConfig& config, const RunOptions& options);
 
+/// The scene a `--restart` of `run_dir` continues: the folder's stored scene with `overrides`,
+/// which may only set [time] keys (InputError naming any other key, or a folder without a
+/// checkpoint); sets `options`' out_dir, restart and restart_overrides.
+scene::SceneConfig restart_scene(const std::string& run_dir, const std::vector<std::string>& overrides,
+                                 RunOptions& options);
+
 /// Path of the checkpoint file in a run folder.
 std::string checkpoint_path(const std::string& run_dir);
 /// Path of the resolved scene stored in a run folder (used by --restart).
