@@ -161,7 +161,7 @@ std::string plot_fit(const rheology::FitResult& r, const Data& d, const std::str
   }
   io::write_file_atomically(curve_csv, c, "plot curve");
 
-  const std::string tmp = png + ".tmp.png";
+  std::string tmp = png + ".tmp.png";
   try {
     run_tool("plot_fit.py", {data_csv, curve_csv, "--kind", rheology::to_string(r.kind), "--phi-m", num(phi_m),
                              "--title", title, tmp});
@@ -224,7 +224,7 @@ std::string plot_curves_fit(const rheology::CurvesFitResult& r, const io::CsvTab
   }
   io::write_file_atomically(curve_csv, c, "plot curve");
 
-  const std::string tmp = png + ".tmp.png";
+  std::string tmp = png + ".tmp.png";
   try {
     run_tool("plot_fit.py", {data_csv, curve_csv, "--kind", "curves", "--residual", rheology::to_string(residual),
                              "--title", title, tmp});

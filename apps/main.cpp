@@ -52,7 +52,17 @@ int main(int argc, char** argv) {
   // A write past a file-size limit (ulimit -f) fails with EFBIG and is reported with the file's
   // name, instead of the signal ending the process mid-write.
   std::signal(SIGXFSZ, SIG_IGN);
-  const int status = run_cli(argc, argv);
+  int status = 3;
+  try {
+    status = run_cli(argc, argv);
+  } catch (const std::exception& e) {
+    // Reporting an error failed in turn (fmt::print throws when stderr is closed or full), or the
+    // CLI could not be set up: an error exit with status 3 (an output that could not be written),
+    // not std::terminate's abort. The message is best effort (std::fprintf does not throw).
+    std::fprintf(stderr, "oobleck: error: %s\n", e.what());
+  } catch (...) {
+    std::fprintf(stderr, "oobleck: error: unknown exception\n");
+  }
   if (oobleck::io::hdf5_file_close_failed()) {  // io/hdf5_state.hpp: skip HDF5's shutdown
     std::fflush(nullptr);
     std::_Exit(status);

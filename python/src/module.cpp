@@ -516,6 +516,9 @@ PYBIND11_MODULE(_oobleck, m) {
   m.doc() = "oobleck's compiled core (pybind11 over liboobleck); use the package oobleck, not this module";
   static py::exception<InputError> input_error(m, "InputError", PyExc_ValueError);
   static py::exception<NumericalError> numerical_error(m, "NumericalError", PyExc_RuntimeError);
+  // pybind11's translator type is the function pointer void (*)(std::exception_ptr): the lambda
+  // must take the pointer by value to convert to it.
+  // NOLINTNEXTLINE(performance-unnecessary-value-param)
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
@@ -608,7 +611,7 @@ PYBIND11_MODULE(_oobleck, m) {
       "the parameter file's text (loads back with load_params to the same values)");
   params.def("__copy__", [](const P& p) { return p; });
   params.def(
-      "__deepcopy__", [](const P& p, py::dict) { return p; }, py::arg("memo"));
+      "__deepcopy__", [](const P& p, const py::dict& /*memo*/) { return p; }, py::arg("memo"));
 
   m.def("flow_curve", &flow_curve, py::arg("params"), py::arg("phi"), py::arg("points"));
   m.def("shear_rate_dst", &shear_rate_dst, py::arg("params"), py::arg("phi"));

@@ -4,6 +4,7 @@
 #include <fstream>
 #include <sstream>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -124,6 +125,17 @@ INSTANTIATE_TEST_SUITE_P(
                 "does not exist"},
         BadCase{"rheology flow-curve --preset hermes2016 --phi 0.4 --points 1 --out {OUT}", "--points"},
         BadCase{"rheology structure --out {OUT}", "--preset NAME or --params FILE"}));
+
+// Reporting the error fails in turn (stderr on a full device: fmt::print throws): still an error
+// exit with status 3, not an exception escaping main() and std::terminate's abort (status 134).
+TEST(RheologyCli, ErrorThatCannotBeReportedIsStatus3NotAnAbort) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  clitest::TempDir d;
+  const auto r = clitest::shell(fmt::format("({} rheology flow-curve --preset nosuch --phi 0.4 --out {} 2>/dev/full)",
+                                            OOBLECK_CLI, d / "fc.csv"));
+  EXPECT_EQ(r.status, 3) << r.output;
+  EXPECT_FALSE(fs::exists(d / "fc.csv"));
+}
 
 TEST(RheologyCli, UnwritableOutputFolder) {
   const auto r = run("rheology flow-curve --preset hermes2016 --phi 0.4 --out /nonexistent_dir/fc.csv");

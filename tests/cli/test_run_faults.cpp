@@ -18,14 +18,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
 #include "oobleck/core/error.hpp"
 #include "oobleck/io/checkpoint.hpp"
-
-extern char** environ;
 
 namespace fs = std::filesystem;
 using namespace oobleck;
@@ -41,6 +40,7 @@ class Child {
     std::vector<std::string> argv_s = {OOBLECK_CLI, "run"};
     argv_s.insert(argv_s.end(), args.begin(), args.end());
     std::vector<char*> argv;
+    argv.reserve(argv_s.size() + 1);
     for (auto& a : argv_s) argv.push_back(a.data());
     argv.push_back(nullptr);
     posix_spawn_file_actions_t fa;
@@ -130,12 +130,12 @@ TEST(RunFaults, SigintAndSigtermStopWithACheckpointAndRestartBitForBit) {
 
     // Continued to 40 steps past the stop, it holds the state of a run never stopped.
     const std::string until = std::to_string(cp.step() + 40);
-    const auto r = clitest::run("run --restart " + out + " --stop-after " + until + " --threads 1 --quiet");
+    const auto r = clitest::run(fmt::format("run --restart {} --stop-after {} --threads 1 --quiet", out, until));
     ASSERT_EQ(r.status, 0) << r.output;
     const std::string ref = d / ("ref" + std::to_string(sig));
-    const auto u = clitest::run(
-        "run " + kSettling + " --set time.duration=1.0 --set output.series_interval=1e-4 --threads 1 --quiet --out " +
-        ref + " --stop-after " + until);
+    const auto u = clitest::run(fmt::format(
+        "run {} --set time.duration=1.0 --set output.series_interval=1e-4 --threads 1 --quiet --out {} --stop-after {}",
+        kSettling, ref, until));
     ASSERT_EQ(u.status, 0) << u.output;
     expect_same_state(io::read_checkpoint(ref + "/checkpoint.h5"), io::read_checkpoint(out + "/checkpoint.h5"));
   }
@@ -221,8 +221,10 @@ TEST(RunFaults, NumericalFailureKeepsTheLastCheckpointAndARestartWithASmallerSte
   clitest::TempDir d;
   const std::string out = d / "rod";
   const std::string rod = std::string(OOBLECK_SOURCE_DIR) + "/scenes/paper/rod_impact.toml";
-  auto r = clitest::run("run " + rod + " --set time.cfl=1.0 --set cell_size=0.0025 --checkpoint-every 20 "
-                        "--stop-after 600 --threads 1 --quiet --out " + out);
+  auto r = clitest::run("run " + rod +
+                        " --set time.cfl=1.0 --set cell_size=0.0025 --checkpoint-every 20 "
+                        "--stop-after 600 --threads 1 --quiet --out " +
+                        out);
   ASSERT_EQ(r.status, 3) << r.output;
   EXPECT_NE(r.output.find("numerical failure"), std::string::npos) << r.output;
   const auto at = r.output.find("at step ");

@@ -24,7 +24,7 @@ namespace oobleck::fuzz {
 
 /// The bytes as a file of this process (the readers take paths, as from the command line).
 inline std::string as_file(const std::uint8_t* data, std::size_t size, const char* suffix) {
-  const std::string path = "/tmp/oobleck_fuzz_" + std::to_string(::getpid()) + suffix;
+  std::string path = "/tmp/oobleck_fuzz_" + std::to_string(::getpid()) + suffix;
   std::ofstream(path, std::ios::binary | std::ios::trunc)
       .write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
   return path;

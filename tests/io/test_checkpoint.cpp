@@ -1,6 +1,8 @@
 // Checkpoints: bit-exact round trip, atomic writing, clear InputError for missing, foreign,
 // truncated, corrupt files and missing datasets.
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <functional>
 #include <filesystem>
@@ -54,7 +56,7 @@ std::string message_of(const std::function<void()>& f) {
 
 /// A small valid checkpoint with one distinctive double array; returns its path.
 std::string write_small(const TempDir& dir, const std::string& name = "cp.h5") {
-  const std::string path = dir.file(name);
+  std::string path = dir.file(name);
   std::vector<double> marker(64);
   for (std::size_t i = 0; i < marker.size(); ++i) marker[i] = 1234.5678 + static_cast<double>(i);
   std::vector<std::int64_t> ids{1, 2, 3};
@@ -109,7 +111,7 @@ TEST(Checkpoint, RoundTripIsBitExact) {
   EXPECT_EQ(cp.file(), path);
   EXPECT_EQ(cp.step(), 123456789012LL);
   const double time_back = cp.time();
-  EXPECT_EQ(std::memcmp(&time, &time_back, sizeof time), 0);
+  EXPECT_EQ(std::bit_cast<std::uint64_t>(time), std::bit_cast<std::uint64_t>(time_back));  // bit for bit
   EXPECT_EQ(cp.config(), config);
   const double dt = 1e-6 / 3.0;
   EXPECT_EQ(cp.real_attribute("dt"), dt);

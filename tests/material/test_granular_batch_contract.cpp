@@ -6,9 +6,10 @@
 // closed form, f_1 Newton solve, separated, the p_tr <= 0 fast path and its nested fallback), the
 // scalar end of step (implicit structure update, forced f = 1, unconverged return maps), invalid
 // inputs, overflow, and the in-plane trials.
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
-#include <cstring>
 #include <limits>
 #include <random>
 #include <string>
@@ -25,6 +26,14 @@ using test::log_uniform;
 using test::random_tensor;
 
 namespace {
+
+/// The n doubles at a and at b are the same bit for bit (signs of zeros and NaN payloads included).
+bool same_bits(const double* a, const double* b, int n) {
+  for (int i = 0; i < n; ++i) {
+    if (std::bit_cast<std::uint64_t>(a[i]) != std::bit_cast<std::uint64_t>(b[i])) return false;
+  }
+  return true;
+}
 
 // advance_batch (the MPM adapter's call: Newton solves in lanes across points) must give the
 // results of advance() point by point, bit for bit, in every regime and on failures: random
@@ -111,10 +120,9 @@ void batch_equals_point_by_point(const std::string& preset_name, std::uint64_t s
         sigma_b[k].data()[e] = sigma_p[k].data()[e] = 0.0;  // +0 both (the sign of a zero may differ)
       }
     }
-    const bool same = std::memcmp(sigma_b[k].data(), sigma_p[k].data(), 9 * sizeof(double)) == 0 &&
-                      std::memcmp(&f_b[k], &f_p[k], sizeof(double)) == 0 && step_b[k].ok == step_p[k].ok &&
-                      step_b[k].regime == step_p[k].regime &&
-                      std::memcmp(&step_b[k].gamma_dot_p, &step_p[k].gamma_dot_p, sizeof(double)) == 0;
+    const bool same = same_bits(sigma_b[k].data(), sigma_p[k].data(), 9) && same_bits(&f_b[k], &f_p[k], 1) &&
+                      step_b[k].ok == step_p[k].ok && step_b[k].regime == step_p[k].regime &&
+                      same_bits(&step_b[k].gamma_dot_p, &step_p[k].gamma_dot_p, 1);
     if (!same && ++mismatches <= 5)
       ADD_FAILURE() << "point " << k << ": batch and point-by-point results differ (phi = " << phi[k] << ")";
   }

@@ -36,7 +36,7 @@ Mat<3, 2> swirl_gradient(double dvtheta_dr) {
 Mat3 axisymmetric_L(double r, double v_theta, double dvtheta_dr) {
   const Vec<2> x(r, 0.0);
   const Vec<3> v(0.0, 0.0, v_theta);
-  const Mat3 L = Axisymmetric::velocity_gradient(swirl_gradient(dvtheta_dr), x, v);
+  Mat3 L = Axisymmetric::velocity_gradient(swirl_gradient(dvtheta_dr), x, v);
   Mat3 Lw;
   const double g0[3] = {0.0, 0.0, dvtheta_dr}, g1[3] = {0.0, 0.0, 0.0};
   const double vv[3] = {0.0, 0.0, v_theta};

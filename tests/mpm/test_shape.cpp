@@ -181,6 +181,7 @@ template <class Kernel>
 void check_inertia_is_the_second_moment(const Kernel& kernel) {
   const Grid<2> g(Vec<2>(-0.3, 0.1), 0.25, {6, 5}, {true, false});
   std::vector<Vec<2>> x;
+  x.reserve(157);
   for (int k = 0; k < 157; ++k)
     x.emplace_back(-0.3 + 1.5 * ((k * 0.6180339887) - std::floor(k * 0.6180339887)),
                    0.1 + 1.25 * ((k * 0.7548776662) - std::floor(k * 0.7548776662)));

@@ -8,7 +8,9 @@
 // periodic seam and next to walls.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <random>
 
@@ -405,7 +407,7 @@ TEST(Transfer, AxisymmetricWithoutSwirlEqualsTheGeneralKernelsBitForBit) {
       ASSERT_EQ(bad, kAllFinite);
       auto same = [](const double* x, const double* y, std::size_t count) {
         for (std::size_t k = 0; k < count; ++k)
-          if (std::memcmp(x + k, y + k, sizeof(double)) != 0) return false;
+          if (std::bit_cast<std::uint64_t>(x[k]) != std::bit_cast<std::uint64_t>(y[k])) return false;
         return true;
       };
       const auto np = static_cast<std::size_t>(b.size());

@@ -51,7 +51,7 @@ struct Owner {
 };
 
 std::string save(const clitest::TempDir& d, Owner& o, const std::string& name = "cp.h5") {
-  const std::string path = d / name;
+  std::string path = d / name;
   io::CheckpointWriter cp(path);
   cp.set_step(7);
   cp.set_time(0.25);

@@ -25,8 +25,8 @@ using namespace oobleck;
 namespace {
 const std::string kScenes = std::string(OOBLECK_SOURCE_DIR) + "/scenes/verification/";
 
-nlohmann::json run_verification(const std::string& scene, const std::string& out, std::vector<std::string> sets = {},
-                                run::RunOptions o = {}) {
+nlohmann::json run_verification(const std::string& scene, const std::string& out,
+                                const std::vector<std::string>& sets = {}, run::RunOptions o = {}) {
   o.out_dir = out;
   o.quiet = true;
   if (o.threads == 0) o.threads = 1;

@@ -23,7 +23,7 @@ std::string read_all(const std::string& p) {
 }
 
 /// Error message of loading a copy of settling.toml with `from` replaced by `to`.
-std::string error_with(const std::string& from, const std::string& to, std::vector<std::string> sets = {}) {
+std::string error_with(const std::string& from, const std::string& to, const std::vector<std::string>& sets = {}) {
   std::string s = read_all(kSettling);
   if (!from.empty()) {
     const auto pos = s.find(from);

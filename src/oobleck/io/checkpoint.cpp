@@ -94,7 +94,9 @@ CheckpointWriter::~CheckpointWriter() {
 
 void CheckpointWriter::set_step(std::int64_t step) { h5::write_attribute(impl_->file.get(), "step", step); }
 void CheckpointWriter::set_time(double time) { h5::write_attribute(impl_->file.get(), "time", time); }
-void CheckpointWriter::set_config(const std::string& c) { h5::write_attribute(impl_->file.get(), "config", c); }
+void CheckpointWriter::set_config(const std::string& resolved_configuration) {
+  h5::write_attribute(impl_->file.get(), "config", resolved_configuration);
+}
 
 void CheckpointWriter::attribute(const std::string& name, double value) {
   check_attribute_name(name);

@@ -393,7 +393,7 @@ std::string write_grid_block(hid_t file, const NodeGrid& grid, const std::string
 
 std::string FrameWriter::write(const Frame& frame) {
   const std::size_t index = entries_.size();
-  const std::string path = frame_path(index);
+  std::string path = frame_path(index);
   const std::string rel = (fs::path(name_) / fs::path(path).filename()).string();  // relative to the .xmf
 
   std::set<std::string> body_names;

@@ -21,7 +21,7 @@ inline void write_json_atomically(const std::string& path, const nlohmann::json&
 
 /// Write RUN_DIR/summary.json; returns its path.
 inline std::string write_summary(const std::string& run_dir, const nlohmann::json& summary) {
-  const std::string path = (std::filesystem::path(run_dir) / "summary.json").string();
+  std::string path = (std::filesystem::path(run_dir) / "summary.json").string();
   write_json_atomically(path, summary, "summary");
   return path;
 }

@@ -183,8 +183,9 @@ class GranularLaw {
   /// so that it equals the value advance_batch computes for the point, bit for bit.
   double inv_eta_B(double phi) const;
   /// 1/eta_B of E8 for numerics::kMathBlock values of phi (0 where phi >= phi_j or phi is NaN), the
-  /// non-integer powers as exp(alpha log(phi_j - phi)) in vector lanes (numerics/vector_math.hpp).
-  void inv_eta_B_block(const double* phi, double* inv_eta_B) const;
+  /// non-integer powers as exp(alpha log(phi_j - phi)) in vector lanes (numerics/vector_math.hpp),
+  /// into r.
+  void inv_eta_B_block(const double* phi, double* r) const;
   /// Structure update (E24, staggered or implicit) after the return map r at f_n, diagnostics and
   /// the final stress; writes state when the result is finite.
   template <bool kDiagnostics>

@@ -317,6 +317,7 @@ FitResult fit_dst(const std::vector<double>& phi, const std::vector<double>& rat
     attempt->x = std::move(start);
     auto problem = std::make_unique<ceres::Problem>();
     std::vector<double*> blocks;
+    blocks.reserve(static_cast<std::size_t>(terms));
     for (int i = 0; i < terms; ++i) blocks.push_back(attempt->x.data() + 2 * i);
     for (std::size_t k = 0; k < phi.size(); ++k) {
       auto* cf = new ceres::DynamicAutoDiffCostFunction<DstResidual, 4>(new DstResidual{ln_gap[k], offset[k], terms});
@@ -344,11 +345,13 @@ FitResult fit_dst(const std::vector<double>& phi, const std::vector<double>& rat
   r.p = 2 * terms;
   fill_statistics(r, best->summary);
   std::vector<const double*> blocks;
+  blocks.reserve(static_cast<std::size_t>(terms));
   for (int i = 0; i < terms; ++i) blocks.push_back(best->x.data() + 2 * i);
   const auto cov = covariance(*best_problem, blocks, r.p);
   r.covariance_ok = !cov.empty();
   auto se = [&](int j) {
-    return r.covariance_ok ? std::sqrt(cov[static_cast<std::size_t>(j * r.p + j)] * r.residual_variance) : kNaN;
+    const auto jj = static_cast<std::size_t>(j);  // the diagonal entry (j, j) of the p x p covariance
+    return r.covariance_ok ? std::sqrt(cov[jj * static_cast<std::size_t>(r.p) + jj] * r.residual_variance) : kNaN;
   };
   // Canonical order: steepest term first (as in the presets).
   std::vector<int> idx(static_cast<std::size_t>(terms));

@@ -403,7 +403,7 @@ CurvesFitResult fit_curves(const std::vector<double>& phi, const std::vector<dou
   }
   const Eigen::MatrixXd Js = J * scale.asDiagonal();
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(Js, Eigen::ComputeThinV);
-  const Eigen::VectorXd sv = svd.singularValues();
+  const Eigen::VectorXd& sv = svd.singularValues();
   const auto last = static_cast<Eigen::Index>(P) - 1;
   if (!(sv(last) > kCondition * sv(0))) {
     const Eigen::VectorXd v = svd.matrixV().col(last);
@@ -419,7 +419,7 @@ CurvesFitResult fit_curves(const std::vector<double>& phi, const std::vector<dou
   }
   // Covariance of the internal parameters: D V S^-2 V^T D s^2, then to natural units.
   const double s2 = n > res.p ? 2.0 * res.cost / (n - res.p) : 0.0;
-  const Eigen::MatrixXd V = svd.matrixV();
+  const Eigen::MatrixXd& V = svd.matrixV();
   const Eigen::VectorXd inv_s2 = sv.array().square().inverse();
   Eigen::MatrixXd cov = scale.asDiagonal() * V * inv_s2.asDiagonal() * V.transpose() * scale.asDiagonal() * s2;
   Eigen::VectorXd dq(static_cast<Eigen::Index>(P));

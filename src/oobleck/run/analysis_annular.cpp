@@ -68,7 +68,7 @@ void AnnularAnalysis<G>::sample_frame() {
   fr.v_theta.origin_x = grid.origin_m[0];
   fr.v_theta.origin_y = grid.origin_m[1];
   fr.v_theta.h = grid.h_m;
-  fr.v_theta.nx = static_cast<std::size_t>(grid.cells[0] + 1);
+  fr.v_theta.nx = static_cast<std::size_t>(grid.cells[0]) + 1;
   fr.v_theta.ny = static_cast<std::size_t>(grid.periodic[1] ? grid.cells[1] : grid.cells[1] + 1);
   fr.v_theta.values.assign(fr.v_theta.nx * fr.v_theta.ny, 0.0);
   for (std::size_t j = 0; j < fr.v_theta.ny; ++j) {

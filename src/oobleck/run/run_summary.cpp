@@ -8,17 +8,17 @@
 
 namespace oobleck::run {
 
-nlohmann::json parameters(const scene::SceneConfig& cfg) {
-  const int D = cfg.grid.dim;
-  const auto& s = cfg.material.steady;
-  const auto& g = cfg.material.granular;
+nlohmann::json parameters(const scene::SceneConfig& config) {
+  const int D = config.grid.dim;
+  const auto& s = config.material.steady;
+  const auto& g = config.material.granular;
   nlohmann::json p;
-  p["preset"] = cfg.material.name;
-  p["phi"] = cfg.regions.front().phi;
+  p["preset"] = config.material.name;
+  p["phi"] = config.regions.front().phi;
   p["rho_s"] = g.rho_s;
-  p["rho_f"] = cfg.fluid.rho_f0_kg_m3;
-  p["eta_0"] = cfg.fluid.eta_0_Pa_s;
-  p["kappa"] = cfg.fluid.kappa_Pa;
+  p["rho_f"] = config.fluid.rho_f0_kg_m3;
+  p["eta_0"] = config.fluid.eta_0_Pa_s;
+  p["kappa"] = config.fluid.kappa_Pa;
   p["d"] = g.d;
   p["G"] = g.G;
   p["K"] = g.K;
@@ -38,19 +38,19 @@ nlohmann::json parameters(const scene::SceneConfig& cfg) {
   nlohmann::json terms = nlohmann::json::array();
   for (const auto& t : s.eta_B_terms) terms.push_back({{"phi_i", t.phi_i}, {"alpha", t.alpha}});
   p["eta_B"] = terms;
-  p["gravity"] = std::vector<double>(cfg.gravity_m_s2.begin(), cfg.gravity_m_s2.begin() + D);
-  p["porosity_min"] = cfg.coupling.porosity_min;
-  p["drag"] = cfg.coupling.drag == scene::DragLaw::Beetstra ? "beetstra" : "carman_kozeny";
-  p["cell_size"] = cfg.grid.cell_size_m;
-  p["cells"] = std::vector<int>(cfg.grid.cells.begin(), cfg.grid.cells.begin() + D);
-  p["shape_function"] = scene::to_string(cfg.grid.shape);
-  p["transfer"] = cfg.transfer.scheme == scene::TransferScheme::Apic ? "apic" : "flip";
-  if (cfg.transfer.scheme == scene::TransferScheme::Flip) p["flip_fraction"] = cfg.transfer.flip_fraction;
-  if (cfg.grid.geometry == scene::Geometry::Axisymmetric) {
-    p["r_inner"] = cfg.grid.origin_m[0];
-    p["r_outer"] = cfg.grid.origin_m[0] + cfg.grid.size_m[0];
-    p["height"] = cfg.grid.size_m[1];
-    if (cfg.boundary[0].type == scene::BoundaryType::Velocity) p["u_inner"] = cfg.boundary[0].velocity_m_s[2];
+  p["gravity"] = std::vector<double>(config.gravity_m_s2.begin(), config.gravity_m_s2.begin() + D);
+  p["porosity_min"] = config.coupling.porosity_min;
+  p["drag"] = config.coupling.drag == scene::DragLaw::Beetstra ? "beetstra" : "carman_kozeny";
+  p["cell_size"] = config.grid.cell_size_m;
+  p["cells"] = std::vector<int>(config.grid.cells.begin(), config.grid.cells.begin() + D);
+  p["shape_function"] = scene::to_string(config.grid.shape);
+  p["transfer"] = config.transfer.scheme == scene::TransferScheme::Apic ? "apic" : "flip";
+  if (config.transfer.scheme == scene::TransferScheme::Flip) p["flip_fraction"] = config.transfer.flip_fraction;
+  if (config.grid.geometry == scene::Geometry::Axisymmetric) {
+    p["r_inner"] = config.grid.origin_m[0];
+    p["r_outer"] = config.grid.origin_m[0] + config.grid.size_m[0];
+    p["height"] = config.grid.size_m[1];
+    if (config.boundary[0].type == scene::BoundaryType::Velocity) p["u_inner"] = config.boundary[0].velocity_m_s[2];
   }
   return p;
 }

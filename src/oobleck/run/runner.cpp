@@ -37,16 +37,18 @@ std::string stored_scene_path(const std::string& run_dir) { return run_dir + "/s
 scene::SceneConfig restart_scene(const std::string& run_dir, const std::vector<std::string>& overrides,
                                  RunOptions& options) {
   if (!std::filesystem::exists(checkpoint_path(run_dir)))
-    throw InputError(fmt::format("restart {}: no checkpoint there ({} is missing); a run writes one every "
-                                 "--checkpoint-every N steps (Python: checkpoint_every=N)",
-                                 run_dir, checkpoint_path(run_dir)));
+    throw InputError(
+        fmt::format("restart {}: no checkpoint there ({} is missing); a run writes one every "
+                    "--checkpoint-every N steps (Python: checkpoint_every=N)",
+                    run_dir, checkpoint_path(run_dir)));
   scene::SceneConfig cfg = scene::load_scene(stored_scene_path(run_dir), overrides);
   for (const auto& spec : overrides) {  // the rest of the scene is the checkpoint's state
     const std::string key = scene::override_key(spec, cfg.aliases);
     if (key.rfind("time.", 0) != 0)
-      throw InputError(fmt::format("restart {} with --set {}: only [time] keys (time.cfl, time.dt, time.duration) "
-                                   "may change on a restart; '{}' is part of the checkpoint's state",
-                                   run_dir, spec, key));
+      throw InputError(
+          fmt::format("restart {} with --set {}: only [time] keys (time.cfl, time.dt, time.duration) "
+                      "may change on a restart; '{}' is part of the checkpoint's state",
+                      run_dir, spec, key));
   }
   options.out_dir = run_dir;
   options.restart = true;
@@ -184,9 +186,10 @@ void SceneRun<G>::write_checkpoint() {
 template <class G>
 void SceneRun<G>::restore(const io::Checkpoint& cp) {
   if (cp.real_attribute("dt") != scene_.dt_s && opt_.restart_overrides.empty()) {
-    throw InputError(fmt::format("{}: time step {} s differs from the checkpoint's {} s (a new time step is "
-                                 "given with --restart DIR --set time.cfl=... or time.dt=...)",
-                                 cp.file(), scene_.dt_s, cp.real_attribute("dt")));
+    throw InputError(
+        fmt::format("{}: time step {} s differs from the checkpoint's {} s (a new time step is "
+                    "given with --restart DIR --set time.cfl=... or time.dt=...)",
+                    cp.file(), scene_.dt_s, cp.real_attribute("dt")));
   }
   restore_fields(cp, state_fields());
   solver().set_clock(cp.time(), cp.step());
@@ -209,9 +212,10 @@ nlohmann::json SceneRun<G>::run() {
   // the outputs' step intervals from the checkpoint's step.
   const bool retimed = opt_.restart && !opt_.restart_overrides.empty();
   const long total =
-      retimed ? first + std::max(0L, static_cast<long>(std::llround((cfg_.time.duration_s - solver().time_s()) /
-                                                                     scene_.dt_s)))
-              : scene_.total_steps;
+      retimed
+          ? first +
+                std::max(0L, static_cast<long>(std::llround((cfg_.time.duration_s - solver().time_s()) / scene_.dt_s)))
+          : scene_.total_steps;
   const long base = retimed ? first : 0;
 
   std::int64_t points = 0;

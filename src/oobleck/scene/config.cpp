@@ -133,6 +133,7 @@ void apply_override(toml::table& root, const std::string& file, const std::strin
     }
     if (node == nullptr) {
       std::vector<std::string> alias_names;
+      alias_names.reserve(aliases.size());
       for (const auto& [a, target] : aliases) alias_names.push_back(a);
       throw InputError(fmt::format(
           "--set {}: {} has no section '{}'{}", spec, file, part,
