@@ -465,6 +465,16 @@ py::tuple run_scene(const std::string& scene, const std::vector<std::string>& se
   }
   bool interrupted = false;
   py::object error_type, error_value, error_trace;
+  // With the GIL held: stop the run, keeping the pending Python exception for the caller.
+  auto stop_with_pending_error = [&] {
+    interrupted = true;
+    PyObject *t = nullptr, *v = nullptr, *tb = nullptr;
+    PyErr_Fetch(&t, &v, &tb);
+    error_type = py::reinterpret_steal<py::object>(t);
+    error_value = py::reinterpret_steal<py::object>(v);
+    error_trace = py::reinterpret_steal<py::object>(tb);
+    return false;
+  };
   using clock = std::chrono::steady_clock;
   auto last = clock::now();
   ro.on_step = [&](long done, long total, double time) {
@@ -472,27 +482,13 @@ py::tuple run_scene(const std::string& scene, const std::vector<std::string>& se
     if (done < total && now - last < std::chrono::milliseconds(100)) return true;
     last = now;
     py::gil_scoped_acquire acquire;
-    if (PyErr_CheckSignals() != 0) {
-      interrupted = true;
-      PyObject *t = nullptr, *v = nullptr, *tb = nullptr;
-      PyErr_Fetch(&t, &v, &tb);
-      error_type = py::reinterpret_steal<py::object>(t);
-      error_value = py::reinterpret_steal<py::object>(v);
-      error_trace = py::reinterpret_steal<py::object>(tb);
-      return false;
-    }
+    if (PyErr_CheckSignals() != 0) return stop_with_pending_error();
     if (!progress.is_none()) {
       try {
         progress(done, total, time);
       } catch (py::error_already_set& e) {
-        interrupted = true;
         e.restore();
-        PyObject *t = nullptr, *v = nullptr, *tb = nullptr;
-        PyErr_Fetch(&t, &v, &tb);
-        error_type = py::reinterpret_steal<py::object>(t);
-        error_value = py::reinterpret_steal<py::object>(v);
-        error_trace = py::reinterpret_steal<py::object>(tb);
-        return false;
+        return stop_with_pending_error();
       }
     }
     return true;
