@@ -14,6 +14,7 @@
 #include "oobleck/rheology/dilation.hpp"
 #include "oobleck/rheology/f_max.hpp"
 #include "oobleck/rheology/flow_curve.hpp"
+#include "oobleck/rheology/least_squares.hpp"
 
 namespace oobleck::rheology {
 namespace {
@@ -102,28 +103,13 @@ double median(std::vector<double> v) {
 }
 
 ceres::Solver::Options solver_options(const FitOptions& options) {
-  ceres::Solver::Options o;
-  o.linear_solver_type = ceres::DENSE_QR;
-  o.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  o.max_num_iterations = options.max_iterations;
-  o.function_tolerance = 1e-12;
-  o.gradient_tolerance = 1e-12;
-  o.parameter_tolerance = 1e-12;
-  o.logging_type = ceres::SILENT;
-  o.minimizer_progress_to_stdout = false;
-  o.num_threads = 1;
-  return o;
+  return detail::levenberg_marquardt(options.max_iterations, 1e-12, 1e-12);
 }
 
-/// Throws NumericalError unless Ceres reports convergence to a usable solution.
 void require_convergence(const ceres::Solver::Summary& s, FitKind kind, const FitOptions& options) {
-  if (s.termination_type != ceres::CONVERGENCE || !std::isfinite(s.final_cost)) {
-    throw NumericalError(
-        fmt::format("{}: the {} fit did not converge after {} iterations ({}: {}); check that the data follow the "
-                    "model's asymptote (E12/E13/E14) and that the base parameter set suits them",
-                    options.where, to_string(kind), s.iterations.size(),
-                    ceres::TerminationTypeToString(s.termination_type), s.message));
-  }
+  detail::require_convergence(s, options.where, to_string(kind),
+                              "check that the data follow the model's asymptote (E12/E13/E14) and that the base "
+                              "parameter set suits them");
 }
 
 /// Covariance of the listed blocks (row-major, full matrix over the concatenated blocks),

@@ -12,6 +12,7 @@
 #include <fmt/ranges.h>
 
 #include "oobleck/core/error.hpp"
+#include "oobleck/rheology/least_squares.hpp"
 #include "oobleck/rheology/steady_states.hpp"
 
 namespace oobleck::rheology {
@@ -343,24 +344,9 @@ CurvesFitResult fit_curves(const std::vector<double>& phi, const std::vector<dou
     if (std::isfinite(lo)) problem.SetParameterLowerBound(x.data(), static_cast<int>(i), lo);
     if (std::isfinite(hi)) problem.SetParameterUpperBound(x.data(), static_cast<int>(i), hi);
   }
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
-  so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  so.max_num_iterations = options.max_iterations;
-  so.function_tolerance = 1e-10;
-  so.gradient_tolerance = 1e-12;
-  so.parameter_tolerance = 1e-10;
-  so.logging_type = ceres::SILENT;
-  so.minimizer_progress_to_stdout = false;
-  so.num_threads = 1;
   ceres::Solver::Summary summary;
-  ceres::Solve(so, &problem, &summary);
-  if (summary.termination_type != ceres::CONVERGENCE || !std::isfinite(summary.final_cost)) {
-    throw NumericalError(fmt::format(
-        "{}: the curves fit did not converge after {} iterations ({}: {}); start from a base set closer to the "
-        "data or fit fewer parameters",
-        w, summary.iterations.size(), ceres::TerminationTypeToString(summary.termination_type), summary.message));
-  }
+  ceres::Solve(detail::levenberg_marquardt(options.max_iterations, 1e-10, 1e-10), &problem, &summary);
+  detail::require_convergence(summary, w, "curves", "start from a base set closer to the data or fit fewer parameters");
 
   CurvesFitResult res;
   res.n = n;
