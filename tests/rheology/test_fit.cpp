@@ -235,7 +235,15 @@ TEST(Fit, NonConvergenceIsNumericalError) {
   const auto d = synthesize(FitKind::low, truth, 0.2, 0.52, 20, 16);
   FitOptions o;
   o.max_iterations = 1;
-  EXPECT_THROW(fit(FitKind::low, d.phi, d.values, truth, o), NumericalError);
+  o.where = "rheometer.csv";
+  try {
+    fit(FitKind::low, d.phi, d.values, truth, o);
+    FAIL() << "one iteration converged";
+  } catch (const NumericalError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind("rheometer.csv: the low fit did not converge after 1 iterations (", 0), 0u) << m;
+    EXPECT_NE(m.find("check that the data follow the model's asymptote"), std::string::npos) << m;
+  }
 }
 
 TEST(Fit, ParseKind) {

@@ -29,13 +29,14 @@ inline ceres::Solver::Options levenberg_marquardt(int max_iterations, double fun
 }
 
 /// Throws NumericalError unless Ceres reports convergence to a finite cost: "WHERE: the KIND fit
-/// did not converge after N iterations (TERMINATION: MESSAGE); HINT".
+/// did not converge after N iterations (TERMINATION: MESSAGE); HINT". N counts the trust-region steps
+/// (Summary::iterations also holds the evaluation at the start).
 inline void require_convergence(const ceres::Solver::Summary& s, std::string_view where, std::string_view kind,
                                 std::string_view hint) {
   if (s.termination_type == ceres::CONVERGENCE && std::isfinite(s.final_cost)) return;
   throw NumericalError(fmt::format("{}: the {} fit did not converge after {} iterations ({}: {}); {}", where, kind,
-                                   s.iterations.size(), ceres::TerminationTypeToString(s.termination_type), s.message,
-                                   hint));
+                                   s.iterations.empty() ? 0 : s.iterations.size() - 1,
+                                   ceres::TerminationTypeToString(s.termination_type), s.message, hint));
 }
 
 }  // namespace oobleck::rheology::detail
