@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include "cli_common.hpp"
+#include "oobleck/core/comm.hpp"
 #include "oobleck/core/error.hpp"
 #include "oobleck/run/runner.hpp"
 #include "oobleck/run/stop.hpp"
@@ -14,7 +15,7 @@ namespace oobleck::cli {
 void add_run_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("run", "run a scene file (two-phase MPM): HDF5/XDMF frames, series.csv, summary.json");
   struct Opts {
-    std::string scene, out, restart;
+    std::string scene, out, restart, ranks_grid;
     std::vector<std::string> sets;
     int threads = 0;
     long checkpoint_every = -1;
@@ -28,6 +29,9 @@ void add_run_command(CLI::App& app) {
                   "override a scene key: key.path=value or a short name from [aliases] (with --restart: [time] "
                   "keys only)");
   cmd->add_option("--threads", o->threads, "OpenMP threads (default: all cores)");
+  cmd->add_option("--ranks-grid", o->ranks_grid,
+                  "under mpirun: ranks per grid axis, e.g. 2x1 or 2x1x1 (default: the split with the fewest ghost "
+                  "nodes)");
   cmd->add_option("--checkpoint-every", o->checkpoint_every, "steps between checkpoints (default: the scene's)");
   cmd->add_option("--restart", o->restart, "continue the run in this folder from its last checkpoint");
   cmd->add_option("--stop-after", o->stop_after, "stop after this many steps in total (leaves a checkpoint)");
@@ -36,6 +40,7 @@ void add_run_command(CLI::App& app) {
     if (o->threads < 0) throw InputError(fmt::format("--threads = {}: must be >= 0", o->threads));
     run::RunOptions ro;
     ro.threads = o->threads;
+    ro.ranks_grid = o->ranks_grid;
     ro.checkpoint_every = o->checkpoint_every;
     ro.quiet = o->quiet;
     ro.stop_after_steps = o->stop_after;
@@ -52,10 +57,12 @@ void add_run_command(CLI::App& app) {
     }
     const run::StopOnSignals stop_on_signals;  // Ctrl-C: checkpoint, summary, exit 130 (main.cpp)
     const auto summary = run::run_scene(cfg, ro);
-    fmt::print("{}: {} points x {} steps in {:.3g} s = {:.3g} point updates/s on {} thread(s); output in {}\n",
-               cfg.name, summary["points"].get<long>(), summary["steps_this_run"].get<long>(),
-               summary["wall_seconds"].get<double>(), summary["point_updates_per_second"].get<double>(),
-               summary["threads"].get<int>(), ro.out_dir);
+    if (!comm::is_root()) return;
+    fmt::print(
+        "{}: {} points x {} steps in {:.3g} s = {:.3g} point updates/s on {} rank(s) x {} thread(s); output in {}\n",
+        cfg.name, summary["points"].get<long>(), summary["steps_this_run"].get<long>(),
+        summary["wall_seconds"].get<double>(), summary["point_updates_per_second"].get<double>(),
+        summary["ranks"].get<int>(), summary["threads"].get<int>(), ro.out_dir);
   });
 }
 

@@ -6,17 +6,24 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <string>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
 #include "cli_common.hpp"
 #include "oobleck/core/build_info.hpp"
+#include "oobleck/core/comm.hpp"
 #include "oobleck/core/error.hpp"
 #include "oobleck/io/hdf5_state.hpp"
 #include "oobleck/run/stop.hpp"
 
 namespace {
+
+/// "oobleck" or, in a run of several MPI ranks, "oobleck (rank r)".
+std::string who() {
+  return oobleck::comm::size() > 1 ? fmt::format("oobleck (rank {})", oobleck::comm::rank()) : "oobleck";
+}
 
 int run_cli(int argc, char** argv) {
   CLI::App app{"oobleck — dense suspension simulator (Baumgarten–Kamrin 2019 model)"};
@@ -31,16 +38,16 @@ int run_cli(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   } catch (const oobleck::run::Stopped& e) {
-    fmt::print(stderr, "oobleck: {}\n", e.what());
+    fmt::print(stderr, "{}: {}\n", who(), e.what());
     return 128 + e.signal();
   } catch (const oobleck::InputError& e) {
-    fmt::print(stderr, "oobleck: error: {}\n", e.what());
+    fmt::print(stderr, "{}: error: {}\n", who(), e.what());
     return 2;
   } catch (const oobleck::NumericalError& e) {
-    fmt::print(stderr, "oobleck: numerical failure: {}\n", e.what());
+    fmt::print(stderr, "{}: numerical failure: {}\n", who(), e.what());
     return 3;
   } catch (const std::exception& e) {
-    fmt::print(stderr, "oobleck: error: {}\n", e.what());
+    fmt::print(stderr, "{}: error: {}\n", who(), e.what());
     return 3;
   }
   return 0;
@@ -52,6 +59,7 @@ int main(int argc, char** argv) {
   // A write past a file-size limit (ulimit -f) fails with EFBIG and is reported with the file's
   // name, instead of the signal ending the process mid-write.
   std::signal(SIGXFSZ, SIG_IGN);
+  oobleck::comm::init(argc, argv);  // MPI only under mpirun (core/comm.hpp)
   int status = 3;
   try {
     status = run_cli(argc, argv);
@@ -63,6 +71,12 @@ int main(int argc, char** argv) {
   } catch (...) {
     std::fprintf(stderr, "oobleck: error: unknown exception\n");
   }
+  // Several ranks: one that fails stops the others (they may be waiting for it in an exchange).
+  if (status != 0 && oobleck::comm::size() > 1) {
+    std::fflush(nullptr);
+    oobleck::comm::abort(status);
+  }
+  oobleck::comm::finalize();
   if (oobleck::io::hdf5_file_close_failed()) {  // io/hdf5_state.hpp: skip HDF5's shutdown
     std::fflush(nullptr);
     std::_Exit(status);

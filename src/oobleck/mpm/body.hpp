@@ -131,6 +131,23 @@ struct Body {
     if (law) law->resize(size());
   }
 
+  /// Resize every point array (and the law's state) to n points; new points are zero.
+  void resize(std::int64_t n) {
+    const auto s = static_cast<std::size_t>(n);
+    mass_kg.resize(s, 0.0);
+    volume_m3.resize(s, 0.0);
+    volume0_m3.resize(s, 0.0);
+    x_m.resize(s, Vec<D>::Zero());
+    v_m_s.resize(s, Vec<NC>::Zero());
+    C_1_s.resize(s, Mat<NC, D>::Zero());
+    L_1_s.resize(s, Mat3::Zero());
+    stress_Pa.resize(s, Mat3::Zero());
+    f_ext_N.resize(s, Vec<NC>::Zero());
+    phi.resize(s, 0.0);
+    div_q_1_s.resize(s, 0.0);
+    if (law) law->resize(n);
+  }
+
   void set_law(std::unique_ptr<StressLaw<G>> l) {
     law = std::move(l);
     if (law) law->resize(size());

@@ -29,7 +29,9 @@
 #include "oobleck/mpm/body.hpp"
 #include "oobleck/mpm/boundary.hpp"
 #include "oobleck/mpm/contact.hpp"
+#include "oobleck/mpm/decomposition.hpp"
 #include "oobleck/mpm/grid.hpp"
+#include "oobleck/mpm/halo.hpp"
 #include "oobleck/mpm/parallel.hpp"
 #include "oobleck/mpm/shape.hpp"
 #include "oobleck/mpm/transfer.hpp"
@@ -112,6 +114,9 @@ struct StepTimings {
   /// p2g includes the shape functions (fused); grid the walls' folding, the grid update, drag and
   /// contact; g2p the walls' conditions on the velocities, the mixture flux and G2P; stress the laws.
   double p2g = 0, grid = 0, g2p = 0, stress = 0;
+  /// Decomposed runs: the exchanges with the other ranks (nodal sums and values, points), part of
+  /// the four above (p2g holds the sums, g2p the values, stress the points' migration).
+  double communication = 0;
   double total() const { return p2g + grid + g2p + stress; }
 };
 
@@ -239,6 +244,37 @@ class Solver {
   }
   int threads() const { return threads_; }
 
+  /// Domain decomposition (decomposition.hpp, docs/mpi.md): from here on this rank solves on its
+  /// block's local grid and keeps only the points inside its block; the step exchanges the
+  /// nodal sums and values with the neighbours and moves points that cross a block face. Call
+  /// once, after the bodies are filled and the boundaries set, before the first step. Third
+  /// bodies (rigid bodies, contact, motors) are not decomposed yet: InputError.
+  void decompose(const Decomposition<D>& dec) {
+    if (dec_) throw InputError("mpm: the solver is already decomposed");
+    for (int b = 0; b < body_count(); ++b)
+      if (rigid_[b].rigid() || !contacts_.empty() || !motors_.empty())
+        throw InputError(
+            fmt::format("mpm: a decomposed run (mpirun -np {}) does not support third bodies yet (body '{}': "
+                        "rigid bodies, contact and motors run on one rank)",
+                        dec.ranks(), bodies_[b]->name));
+    dec_ = std::make_unique<Decomposition<D>>(dec);
+    grid_ = dec_->local_grid();
+    for (int a = 0; a < D; ++a) {  // faces inside the domain (or across a split periodic axis) are open
+      if (!dec_->split(a)) continue;
+      if (dec_->coords()[a] > 0 || dec_->global().periodic[a]) bc_[2 * a] = FaceCondition{};
+      if (dec_->coords()[a] < dec_->dims()[a] - 1 || dec_->global().periodic[a]) bc_[2 * a + 1] = FaceCondition{};
+    }
+    for (auto& f : fields_) f.resize(grid_.node_count(), threads_);
+    for (auto& b : bodies_) keep_owned_points(*b, *dec_);
+    halo_ = std::make_unique<Halo<D>>(*dec_, grid_);
+  }
+  /// The decomposition, or nullptr (one rank).
+  const Decomposition<D>* decomposition() const { return dec_.get(); }
+  /// Bytes this rank sent in the nodal exchanges so far (0 on one rank).
+  std::int64_t halo_bytes_sent() const { return halo_ ? halo_->bytes_sent() : 0; }
+  /// Points that left this rank for another so far (0 on one rank).
+  std::int64_t points_migrated() const { return points_migrated_; }
+
   /// Largest stable Δt [s]: the CFL condition on the fastest wave of every body
   /// (Δt ≤ cfl h / (c + |v|_max)) and the laws' viscous limits ρ h²/(2η) (model.md §6). The
   /// drag is semi-implicit and never limits Δt.
@@ -250,6 +286,10 @@ class Solver {
       for (const auto& v : b->v_m_s) vmax = std::max(vmax, v.norm());
       c_max = std::max(c_max, c + vmax);
       if (b->law) dt_visc = std::min(dt_visc, b->law->viscous_dt_limit(*b, grid_.h_m));
+    }
+    if (dec_) {  // every rank's points
+      c_max = comm::max(c_max);
+      dt_visc = comm::min(dt_visc);
     }
     return std::min(c_max > 0.0 ? cfl * grid_.h_m / c_max : INFINITY, dt_visc);
   }
@@ -269,8 +309,9 @@ class Solver {
     with_support([&](auto S) {
       constexpr int K = ipow(decltype(S)::value, D);
       StepClock clock(timings_);
-      apply_motors();              // 1. motors: velocity-level drive of driven bodies (§8)
-      particles_to_grid_all<K>();  // 2. P2G: shape functions, mass, momentum, forces, gravity
+      apply_motors();                                       // 1. motors: velocity-level drive of driven bodies (§8)
+      particles_to_grid_all<K>();                           // 2. P2G: shape functions, mass, momentum, forces, gravity
+      if (halo_) timed_exchange([&] { sum_to_owners(); });  // (decomposed: partial sums to the owners)
       clock.lap(timings_.p2g);
       prepare_contact_arrays();
       update_grid_and_couple(                           // 3. grid: walls fold ghosts, rigid predictions; porosity,
@@ -282,6 +323,12 @@ class Solver {
                                                 // 6. G2P: x, v (APIC or FLIP/PIC), C, L, V ← V exp(Δt tr L);
                                                 // 7. laws: stresses (and their state) from L
       keep_mixture_out_of_free_rigid_bodies();  // 8. mixture points back out of free rigid bodies (§8)
+      if (dec_) {                               // (decomposed: points to their new blocks)
+        timed_exchange([&] {
+          for (auto& b : bodies_) points_migrated_ += migrate_points(*b, *dec_);
+        });
+        clock.lap(timings_.stress);
+      }
     });
     time_s_ += opt_.dt_s;
     ++steps_;
@@ -358,6 +405,34 @@ class Solver {
   }
 
   bool mixture() const { return grains_ >= 0 && fluid_ >= 0; }
+
+  template <class F>
+  void timed_exchange(F&& f) {
+    const double t0 = parallel::wall_time();
+    f();
+    timings_.communication += parallel::wall_time() - t0;
+  }
+
+  /// Decomposed runs, after P2G: every body's nodal sums (mass, momentum, force; the fluid's
+  /// pressure force and mixture volume) completed on their owners (halo.hpp).
+  void sum_to_owners() {
+    std::vector<NodalArray> arrays;
+    for (int b = 0; b < body_count(); ++b) {
+      GridField<G>& f = fields_[b];
+      arrays.insert(arrays.end(), {nodal(f.mass_kg), nodal(f.momentum), nodal(f.force_N)});
+      if (b == fluid_) arrays.insert(arrays.end(), {nodal(f.pressure_force_N), nodal(f.volume_m3)});
+    }
+    halo_->sum(arrays);
+  }
+
+  /// Decomposed runs, after the walls' conditions: the owners' nodal velocities (and the nodal
+  /// porosity) copied out to the neighbours, for the flux and G2P (halo.hpp).
+  void copy_from_owners() {
+    std::vector<NodalArray> arrays;
+    for (auto& f : fields_) arrays.insert(arrays.end(), {nodal(f.velocity), nodal(f.velocity_old)});
+    if (fluid_ >= 0) arrays.push_back(nodal(porosity_));
+    halo_->copy(arrays);
+  }
 
   /// Phase 3, the grid pass: the grid update of every body, with the phase coupling for the
   /// mixture. Its parts are node-local, so they run in one pass over the nodes (couple_nodes).
@@ -712,6 +787,10 @@ class Solver {
       // field: the bodies in parallel; the barrier: the flux reads the constrained velocities).
       team.dynamic(nb, 1, [&](std::int64_t b) { apply_boundary_conditions<G>(grid_, bc_, fields_[b], opt_.dt_s); });
       team.barrier();
+      if (halo_) {  // decomposed: the owners' velocities (and porosity) out to the neighbours' copies
+        if (team.rank() == 0) timed_exchange([&] { copy_from_owners(); });
+        team.barrier();
+      }
       // Phase 5b: the mixture flux and the swirl test, node by node.
       std::uint64_t mine = 0;
       if (node_pass_parallel) {
@@ -743,8 +822,11 @@ class Solver {
     clock.lap(timings_.stress);
   }
 
-  Grid<D> grid_;
+  Grid<D> grid_;  ///< the grid this rank solves on (its block's local grid when decomposed)
   SolverOptions<G> opt_;
+  std::unique_ptr<Decomposition<D>> dec_;  ///< decomposed runs only
+  std::unique_ptr<Halo<D>> halo_;
+  std::int64_t points_migrated_ = 0;
   BoundaryConditions<D> bc_{};
   std::vector<std::unique_ptr<Body<G>>> bodies_;
   std::vector<RigidMotion<G>> rigid_;      ///< per body: deformable, prescribed or free rigid

@@ -3,6 +3,7 @@
 // analysis.average_from, against the drag-buoyancy balance.
 #include <cmath>
 
+#include "oobleck/core/comm.hpp"
 #include "oobleck/material/drag.hpp"
 #include "oobleck/run/analysis_kinds.hpp"
 
@@ -28,20 +29,24 @@ class SettlingAnalysis final : public SceneAnalysis<G> {
     const auto& reg = cfg_.regions.front();
     const double z0 = reg.min_m[D - 1], z1 = reg.max_m[D - 1];
     const double lo = z0 + 0.25 * (z1 - z0), hi = z1 - 0.25 * (z1 - z0);
-    auto mean_v = [&](const mpm::Body<G>& body, double& volume) {
-      double mv = 0.0, m = 0.0;
-      volume = 0.0;
+    auto mean_v = [&](const mpm::Body<G>& body, double* sums) {
+      double mv = 0.0, m = 0.0, volume = 0.0;
       for (std::int64_t p = 0; p < body.size(); ++p) {
         if (body.x_m[p][D - 1] < lo || body.x_m[p][D - 1] > hi) continue;
         mv += body.mass_kg[p] * body.v_m_s[p][D - 1];
         m += body.mass_kg[p];
         volume += body.volume_m3[p];
       }
-      return m > 0 ? mv / m : 0.0;
+      sums[0] = mv;
+      sums[1] = m;
+      sums[2] = volume;
     };
-    double vol_s = 0.0, vol_f = 0.0;
-    const double vs = mean_v(this->solver().body(scene_.grains), vol_s);
-    const double vf = mean_v(this->solver().body(scene_.fluid), vol_f);
+    double sums[6];  // grains' and fluid's Σ m v, Σ m, Σ V (decomposed runs: over every rank)
+    mean_v(this->solver().body(scene_.grains), sums);
+    mean_v(this->solver().body(scene_.fluid), sums + 3);
+    if (this->solver().decomposition()) comm::sum(sums);
+    const double vs = sums[1] > 0 ? sums[0] / sums[1] : 0.0;
+    const double vf = sums[4] > 0 ? sums[3] / sums[4] : 0.0;
     const double phi = reg.phi;
     const double j = phi * vs + (1.0 - phi) * vf;
     this->settling_.sum += -(vs - j);

@@ -9,7 +9,9 @@
 
 #include <fmt/format.h>
 
+#include "oobleck/core/comm.hpp"
 #include "oobleck/mpm/fields.hpp"
+#include "oobleck/mpm/halo.hpp"
 #include "oobleck/run/nodal_fields.hpp"
 
 namespace oobleck::run {
@@ -83,7 +85,8 @@ std::optional<io::NodeGrid> node_grid(const scene::BuiltScene<G>& scene, Columns
   scene.solver->declare_grid_fields(list);
   const std::vector<const mpm::PersistentField*> shown = list.frame_fields();
   if (shown.empty()) return std::nullopt;
-  const auto& grid = scene.solver->grid();
+  const auto* dec = scene.solver->decomposition();
+  const auto& grid = dec ? dec->global() : scene.solver->grid();  // (decomposed: gathered on rank 0)
   std::array<std::size_t, 3> nodes{1, 1, 1};
   for (int a = 0; a < D; ++a) nodes[a] = static_cast<std::size_t>(grid.periodic[a] ? grid.cells[a] : grid.cells[a] + 1);
   std::array<double, 3> origin{0, 0, 0}, spacing{0, 0, 0};
@@ -95,6 +98,11 @@ std::optional<io::NodeGrid> node_grid(const scene::BuiltScene<G>& scene, Columns
   for (const mpm::PersistentField* f : shown) {
     const auto& stored = std::get<std::span<double>>(f->data);
     auto& values = column.add(nodes[0] * nodes[1] * nodes[2]);
+    if (dec) {
+      values = mpm::gather_physical_nodes<D>(*dec, scene.solver->grid(), stored);
+      if (comm::is_root()) ng.scalar(f->shown_as(), values);
+      continue;
+    }
     for (std::size_t k = 0; k < nodes[2]; ++k) {
       for (std::size_t j = 0; j < nodes[1]; ++j) {
         for (std::size_t i = 0; i < nodes[0]; ++i) {
@@ -113,15 +121,21 @@ std::optional<io::NodeGrid> node_grid(const scene::BuiltScene<G>& scene, Columns
 }  // namespace
 
 template <class G>
-void write_frame(io::FrameWriter& frames, const scene::BuiltScene<G>& scene) {
-  const auto& solver = *scene.solver;
+void write_frame(io::FrameWriter* frames, const scene::BuiltScene<G>& scene) {
+  auto& solver = *scene.solver;
+  // Decomposed: every rank's points gathered onto rank 0 for the frame (mpm/halo.hpp), then back.
+  std::vector<std::int64_t> own;
+  if (solver.decomposition())
+    for (int b = 0; b < solver.body_count(); ++b) own.push_back(mpm::gather_points_to_root(solver.body(b)));
   io::Frame frame;
   frame.time = solver.time_s();
   frame.step = solver.steps();
   Columns column(64 * static_cast<std::size_t>(solver.body_count()) + 16);
-  for (int b = 0; b < solver.body_count(); ++b) frame.bodies.push_back(body_cloud(scene, b, column));
+  if (frames != nullptr)
+    for (int b = 0; b < solver.body_count(); ++b) frame.bodies.push_back(body_cloud(scene, b, column));
   if (auto grid = node_grid(scene, column)) frame.grid = std::move(*grid);
-  frames.write(frame);
+  for (std::size_t b = 0; b < own.size(); ++b) solver.body(static_cast<int>(b)).resize(own[b]);
+  if (frames != nullptr) frames->write(frame);
 }
 
 template <class G>
@@ -163,6 +177,18 @@ std::vector<double> series_row(const scene::BuiltScene<G>& scene) {
     for (const auto& v : body.v_m_s) vmax = std::max(vmax, v.norm());
     r.push_back(vmax);
   }
+  if (solver.decomposition()) {  // every rank's points: sums, and the largest speed
+    std::vector<double> sums;
+    for (int b = 0; b < solver.body_count(); ++b) {
+      const std::size_t at = 2 + static_cast<std::size_t>(b) * (NC + 3);
+      sums.insert(sums.end(), r.begin() + static_cast<long>(at), r.begin() + static_cast<long>(at + NC + 2));
+      r[at + NC + 2] = comm::max(r[at + NC + 2]);
+    }
+    comm::sum(sums);
+    for (int b = 0; b < solver.body_count(); ++b)
+      std::copy_n(sums.begin() + static_cast<long>(b) * (NC + 2), NC + 2,
+                  r.begin() + static_cast<long>(2 + static_cast<std::size_t>(b) * (NC + 3)));
+  }
   for (const auto& tb : scene.third) {
     const mpm::Vec<D> c = centre_of_mass(solver.body(tb.body), solver.grid());
     for (int k = 0; k < D; ++k) r.push_back(c[k]);
@@ -179,7 +205,7 @@ std::vector<double> series_row(const scene::BuiltScene<G>& scene) {
 }
 
 #define OOBLECK_INSTANTIATE_OUTPUT(G)                                            \
-  template void write_frame(io::FrameWriter&, const scene::BuiltScene<G>&);      \
+  template void write_frame(io::FrameWriter*, const scene::BuiltScene<G>&);      \
   template std::vector<std::string> series_columns(const scene::BuiltScene<G>&); \
   template std::vector<double> series_row(const scene::BuiltScene<G>&)
 OOBLECK_INSTANTIATE_OUTPUT(mpm::PlaneStrain);

@@ -12,14 +12,16 @@ namespace oobleck::run {
 
 /// Write one frame: per body its points' position, velocity, stress, pressure (fluid_pressure for
 /// the fluid), mass and volume; the grains' f, phi, tau_bar, regime, gamma_dot_p; the fluid's phi
-/// and J; and the nodal porosity on the physical nodes when there is a mixture.
+/// and J; and the nodal porosity on the physical nodes when there is a mixture. Decomposed runs:
+/// called on every rank, which gathers the whole frame on rank 0; `frames` is nullptr elsewhere.
 template <class G>
-void write_frame(io::FrameWriter& frames, const scene::BuiltScene<G>& scene);
+void write_frame(io::FrameWriter* frames, const scene::BuiltScene<G>& scene);
 
 /// series.csv: time, step; per body its kinetic energy, momentum, mass and largest speed; per
 /// [[body]] entry its centre of mass and contact force, and its motor's ω and torque.
 template <class G>
 std::vector<std::string> series_columns(const scene::BuiltScene<G>& scene);
+/// (Decomposed runs: called on every rank; the row covers every rank's points.)
 template <class G>
 std::vector<double> series_row(const scene::BuiltScene<G>& scene);
 

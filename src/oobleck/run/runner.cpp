@@ -11,8 +11,11 @@
 #include <fmt/format.h>
 
 #include "oobleck/core/build_info.hpp"
+#include "oobleck/core/comm.hpp"
 #include "oobleck/core/error.hpp"
 #include "oobleck/io/checkpoint.hpp"
+#include "oobleck/mpm/decomposition.hpp"
+#include "oobleck/mpm/halo.hpp"
 #include "oobleck/io/frames.hpp"
 #include "oobleck/io/output_file.hpp"
 #include "oobleck/io/progress.hpp"
@@ -80,14 +83,18 @@ class SceneRun {
   long steps_between(double interval_s, long fallback) const {
     return interval_s > 0 ? std::max(1L, static_cast<long>(std::llround(interval_s / scene_.dt_s))) : fallback;
   }
+  void check_decomposable() const;
+  mpm::Decomposition<G::dim> layout() const;
+  void decompose();
   void make_run_folder();
   void start(std::optional<io::FrameWriter>& frames, std::optional<io::SeriesWriter>& series);
-  void write_frame(io::FrameWriter& frames);
+  void write_frame(io::FrameWriter* frames);
   void take_due_snapshots(bool final_step);
   void check_finite() const;
   /// Everything a restart needs (run/checkpoint_state.hpp): solver, snapshots, analysis.
   mpm::FieldList state_fields();
   void write_checkpoint();
+  void write_checkpoint_file();
   void restore(const io::Checkpoint& cp);
   nlohmann::json summary(long steps_run, bool complete, double wall_s) const;
 
@@ -101,8 +108,55 @@ class SceneRun {
   std::optional<io::RunFolderLock> lock_;  ///< held from before the first write to the end
 };
 
+/// What a decomposed run (several MPI ranks, docs/mpi.md) supports yet; InputError before any
+/// output otherwise. Also: --ranks-grid on one rank.
+template <class G>
+void SceneRun<G>::check_decomposable() const {
+  const int ranks = comm::size();
+  if (ranks == 1) {
+    if (!opt_.ranks_grid.empty()) {
+      const auto dims = mpm::parse_ranks_grid<G::dim>(opt_.ranks_grid, "--ranks-grid");
+      int n = 1;
+      for (int d : dims) n *= d;
+      if (n != 1)
+        throw InputError(fmt::format("--ranks-grid {}: {} ranks, but this run has 1 (start it with mpirun -np {})",
+                                     opt_.ranks_grid, n, n));
+    }
+    return;
+  }
+  const auto kind = cfg_.analysis.kind;
+  if (kind != scene::AnalysisKind::None && kind != scene::AnalysisKind::Settling)
+    throw InputError(
+        fmt::format("{}: [analysis] kind = \"{}\" does not run decomposed yet (mpirun -np {}); run it on "
+                    "one rank (threads: --threads)",
+                    cfg_.file, scene::to_string(kind), ranks));
+  if (!scene_.third.empty())
+    throw InputError(
+        fmt::format("{}: [[body]] '{}': third bodies (rigid, driven, elastic with contact) do not run "
+                    "decomposed yet (mpirun -np {}); run the scene on one rank",
+                    cfg_.file, scene_.third.front().cfg->name, ranks));
+  if (!cfg_.analysis.snapshot_times_s.empty())
+    throw InputError(
+        fmt::format("{}: analysis.snapshot_times: snapshots are not written by decomposed runs yet", cfg_.file));
+  (void)layout();  // a --ranks-grid that does not fit the ranks or the grid: refused before any output
+}
+
+template <class G>
+mpm::Decomposition<G::dim> SceneRun<G>::layout() const {
+  std::array<int, G::dim> dims{};
+  if (!opt_.ranks_grid.empty()) dims = mpm::parse_ranks_grid<G::dim>(opt_.ranks_grid, "--ranks-grid");
+  return mpm::Decomposition<G::dim>(solver().grid(), comm::size(), comm::rank(), dims);
+}
+
+/// Several ranks: keep this rank's block of the scene that every rank built (or restored).
+template <class G>
+void SceneRun<G>::decompose() {
+  if (comm::size() > 1) solver().decompose(layout());
+}
+
 template <class G>
 void SceneRun<G>::make_run_folder() {
+  if (!comm::is_root()) return;  // (rank 0 writes every file of a decomposed run)
   std::error_code ec;
   fs::create_directories(opt_.out_dir, ec);
   if (ec || !fs::is_directory(opt_.out_dir))
@@ -115,9 +169,13 @@ void SceneRun<G>::make_run_folder() {
 /// holds its samples), or new with the state at t = 0 written and sampled.
 template <class G>
 void SceneRun<G>::start(std::optional<io::FrameWriter>& frames, std::optional<io::SeriesWriter>& series) {
+  const bool root = comm::is_root();
   if (opt_.restart) {
+    // Every rank restores the whole checkpoint (any rank count wrote it), then keeps its block.
     const io::Checkpoint cp = io::read_checkpoint(checkpoint_path(opt_.out_dir));
     restore(cp);
+    decompose();
+    if (!root) return;
     // New [time] settings (RunOptions::restart_overrides): a later plain --restart keeps them.
     if (!opt_.restart_overrides.empty())
       io::write_file_atomically(stored_scene_path(opt_.out_dir), cfg_.resolved_toml, "scene copy");
@@ -125,17 +183,21 @@ void SceneRun<G>::start(std::optional<io::FrameWriter>& frames, std::optional<io
     series.emplace(io::SeriesWriter::resume(opt_.out_dir + "/series.csv", series_columns(scene_), cp.time()));
     return;
   }
-  io::write_file_atomically(stored_scene_path(opt_.out_dir), cfg_.resolved_toml, "scene copy");
-  frames.emplace(opt_.out_dir);
-  series.emplace(opt_.out_dir + "/series.csv", series_columns(scene_));
-  write_frame(*frames);
-  series->row(series_row(scene_));
+  decompose();
+  if (root) {
+    io::write_file_atomically(stored_scene_path(opt_.out_dir), cfg_.resolved_toml, "scene copy");
+    frames.emplace(opt_.out_dir);
+    series.emplace(opt_.out_dir + "/series.csv", series_columns(scene_));
+  }
+  write_frame(frames ? &*frames : nullptr);
+  const auto row = series_row(scene_);
+  if (series) series->row(row);
   analysis_->sample();
   take_due_snapshots(false);
 }
 
 template <class G>
-void SceneRun<G>::write_frame(io::FrameWriter& frames) {
+void SceneRun<G>::write_frame(io::FrameWriter* frames) {
   run::write_frame(frames, scene_);
   analysis_->at_frame();
 }
@@ -173,6 +235,18 @@ mpm::FieldList SceneRun<G>::state_fields() {
 
 template <class G>
 void SceneRun<G>::write_checkpoint() {
+  if (solver().decomposition()) {  // every rank's points onto rank 0, which writes them; then back
+    std::vector<std::int64_t> own;
+    for (int b = 0; b < solver().body_count(); ++b) own.push_back(mpm::gather_points_to_root(solver().body(b)));
+    if (comm::is_root()) write_checkpoint_file();
+    for (int b = 0; b < solver().body_count(); ++b) solver().body(b).resize(own[static_cast<std::size_t>(b)]);
+    return;
+  }
+  write_checkpoint_file();
+}
+
+template <class G>
+void SceneRun<G>::write_checkpoint_file() {
   io::CheckpointWriter cp(checkpoint_path(opt_.out_dir));
   cp.set_step(solver().steps());
   cp.set_time(solver().time_s());
@@ -197,6 +271,7 @@ void SceneRun<G>::restore(const io::Checkpoint& cp) {
 
 template <class G>
 nlohmann::json SceneRun<G>::run() {
+  check_decomposable();
   make_run_folder();
   const long every_frame = steps_between(cfg_.output.frame_interval_s, std::numeric_limits<long>::max());
   const long every_series = steps_between(cfg_.output.series_interval_s, 100);
@@ -220,8 +295,9 @@ nlohmann::json SceneRun<G>::run() {
 
   std::int64_t points = 0;
   for (int b = 0; b < solver().body_count(); ++b) points += solver().body(b).size();
+  points = comm::sum(points);
   io::ProgressOptions po;
-  po.quiet = opt_.quiet;
+  po.quiet = opt_.quiet || !comm::is_root();
   po.points_per_step = static_cast<double>(points);
   po.label = cfg_.name;
   io::Progress progress(static_cast<std::uint64_t>(total), po);
@@ -230,6 +306,7 @@ nlohmann::json SceneRun<G>::run() {
   solver().reset_timings();
   const auto t0 = std::chrono::steady_clock::now();
   std::string stopped_by;  // a caller's (on_step) or a signal's stop before the last step
+  const bool decomposed = solver().decomposition() != nullptr;
   for (long s = first + 1; s <= last; ++s) {
     for (const auto& tb : scene_.third)  // prescribed bodies ramping up to speed
       if (tb.cfg->ramp_time_s > 0.0)
@@ -242,8 +319,11 @@ nlohmann::json SceneRun<G>::run() {
     const long k = s - base;
     if (k % every_sample == 0 || final_step) analysis_->sample();
     take_due_snapshots(final_step);
-    if (k % every_frame == 0 || final_step) write_frame(*frames);
-    if (k % every_series == 0 || final_step) series->row(series_row(scene_));
+    if (k % every_frame == 0 || final_step) write_frame(frames ? &*frames : nullptr);
+    if (k % every_series == 0 || final_step) {
+      const auto row = series_row(scene_);
+      if (series) series->row(row);
+    }
     if (every_cp > 0 && k % every_cp == 0) write_checkpoint();
     progress.update(static_cast<std::uint64_t>(s), solver().time_s());
     if (opt_.on_step && !opt_.on_step(s, total, solver().time_s())) {
@@ -251,7 +331,8 @@ nlohmann::json SceneRun<G>::run() {
       last = s;
       break;
     }
-    if (stop_requested() && s < last) {  // run/stop.hpp: after this step's output
+    // run/stop.hpp: after this step's output (decomposed: a signal to any rank stops them all)
+    if ((decomposed ? comm::any(stop_requested()) : stop_requested()) && s < last) {
       stopped_by = stop_reason(stop_signal());
       last = s;
       break;
@@ -260,12 +341,12 @@ nlohmann::json SceneRun<G>::run() {
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (last < total) write_checkpoint();  // stopped early: leave a checkpoint to continue from
   progress.finish();
-  frames->flush();
+  if (frames) frames->flush();
 
   nlohmann::json j = summary(last - first, last == total, wall);
   if (!stopped_by.empty()) j["stopped_by"] = stopped_by;
   if (retimed) j["restart_overrides"] = opt_.restart_overrides;
-  io::write_summary(opt_.out_dir, j);
+  if (comm::is_root()) io::write_summary(opt_.out_dir, j);
   if (!stopped_by.empty() && stopped_by != "caller") {
     throw Stopped(fmt::format("{}: stopped by {} after step {} (t = {:.6g} s); the checkpoint is written: continue "
                               "with `oobleck run --restart {}`",
@@ -281,8 +362,10 @@ nlohmann::json SceneRun<G>::summary(long steps_run, bool complete, double wall_s
   nlohmann::json per_body;
   for (int b = 0; b < solver().body_count(); ++b) {
     points += solver().body(b).size();
-    per_body[solver().body(b).name] = solver().body(b).size();
+    per_body[solver().body(b).name] = comm::sum(solver().body(b).size());
   }
+  const std::int64_t own_points = points;
+  points = comm::sum(points);
   const auto& tm = solver().timings();
   nlohmann::json j;
   j["scene"] = cfg_.name;
@@ -299,11 +382,24 @@ nlohmann::json SceneRun<G>::summary(long steps_run, bool complete, double wall_s
   j["point_updates_per_second"] =
       wall_s > 0 ? static_cast<double>(points) * static_cast<double>(steps_run) / wall_s : 0.0;
   j["threads"] = solver().threads();
+  j["ranks"] = comm::size();
+  if (const auto* dec = solver().decomposition()) {
+    j["ranks_grid"] = dec->dims_string();
+    j["points_per_rank"] = {{"min", comm::min(own_points)},
+                            {"mean", static_cast<double>(points) / comm::size()},
+                            {"max", comm::max(own_points)}};
+    j["points_migrated"] = comm::sum(solver().points_migrated());
+    j["halo_bytes_sent_per_rank_per_step"] =
+        steps_run > 0
+            ? static_cast<double>(comm::sum(solver().halo_bytes_sent())) / comm::size() / static_cast<double>(steps_run)
+            : 0.0;
+  }
   j["library_instruction_set"] = library_instruction_set();  // which CPU variant ran
   j["timings_seconds"] = {{"p2g", tm.p2g},
                           {"grid", tm.grid},
                           {"g2p", tm.g2p},
                           {"stress", tm.stress},
+                          {"communication", comm::max(tm.communication)},
                           {"output_and_checks", wall_s - tm.total()}};
   j["parameters"] = parameters(cfg_);
   j.update(analysis_->result());

@@ -13,8 +13,11 @@
 namespace oobleck::run {
 
 struct RunOptions {
-  std::string out_dir;         ///< run folder (created)
-  int threads = 0;             ///< OpenMP threads (0: default)
+  std::string out_dir;  ///< run folder (created)
+  int threads = 0;      ///< OpenMP threads (0: default)
+  /// Decomposed runs (several MPI ranks): ranks per grid axis, "2x1" or "2x1x1" (empty: chosen,
+  /// mpm/decomposition.hpp).
+  std::string ranks_grid;
   long checkpoint_every = -1;  ///< steps between checkpoints (-1: the scene's value)
   bool quiet = false;          ///< no progress output
   bool restart = false;        ///< continue from out_dir/checkpoint.h5

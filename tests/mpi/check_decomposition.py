@@ -1,0 +1,235 @@
+#!/usr/bin/python3
+"""Decomposed runs against one-rank runs (docs/mpi.md, "What is checked").
+
+Runs `oobleck run` under mpirun on 1, 2 and 3 ranks (and 2 ranks x 2 threads) and checks that the
+decomposition changes nothing but round-off: the same points, every point's mass bit for bit,
+total mass and momentum, the scene's measurement, and every point's position, velocity and stress
+after 200 steps (points matched by position; differences relative to the field's largest
+magnitude). Also restarts on a different rank count, and bad input on several ranks.
+
+usage: check_decomposition.py --oobleck BIN --case CASE --work DIR
+"""
+import argparse
+import glob
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+SETTLING_3D = os.path.join(ROOT, "scenes/verification/settling_3d.toml")
+SETTLING_2D = os.path.join(ROOT, "scenes/verification/settling.toml")
+# 200 steps (dt = 2.79e-5 s), frames at steps 0, 100 and 200, the average from step ~36 on.
+SHORT = ["--set", "time.duration=0.0056", "--set", "analysis.average_from=0.001",
+         "--set", "output.frame_interval=0.0028"]
+
+failures = []
+
+
+def check(ok, what):
+    print(("ok   " if ok else "FAIL ") + what)
+    if not ok:
+        failures.append(what)
+
+
+def oobleck(args, ranks, threads=1, timeout=300):
+    """Run BIN run ARGS on `ranks` MPI ranks (0: without mpirun). Returns (status, stderr)."""
+    cmd = [BIN, "run"] + args + ["--threads", str(threads), "--quiet"]
+    if ranks > 0:
+        cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-np", str(ranks)] + cmd
+    p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    return p.returncode, p.stderr
+
+
+def run_ok(out, scene, ranks, threads=1, extra=()):
+    shutil.rmtree(out, ignore_errors=True)
+    rc, err = oobleck([scene, "--out", out] + SHORT + list(extra), ranks, threads)
+    check(rc == 0, f"{os.path.basename(out)}: exit status {rc}" + ("" if rc == 0 else f"\n{err[-2000:]}"))
+    return out
+
+
+def summary(d):
+    with open(os.path.join(d, "summary.json")) as f:
+        return json.load(f)
+
+
+def last_series_row(d):
+    with open(os.path.join(d, "series.csv")) as f:
+        lines = [l for l in f.read().splitlines() if l and not l.startswith("#")]
+    head = lines[0].split(",")
+    return dict(zip(head, map(float, lines[-1].split(","))))
+
+
+def final_frame(d):
+    files = sorted(glob.glob(os.path.join(d, "frames", "frame_*.h5")))
+    out = {}
+    with h5py.File(files[-1], "r") as f:
+        for body in f["bodies"]:
+            g = f["bodies"][body]
+            out[body] = {k: np.array(g[k]) for k in ("position", "velocity", "stress", "mass", "volume")}
+    return out
+
+
+def match(ref_x, x):
+    """Index into ref_x of each point of x (nearest position)."""
+    idx = np.empty(len(x), dtype=np.int64)
+    for s in range(0, len(x), 512):
+        d = ((x[s:s + 512, None, :] - ref_x[None, :, :]) ** 2).sum(axis=2)
+        idx[s:s + 512] = d.argmin(axis=1)
+    return idx
+
+
+def compare(ref, run, label, settling_tol=1e-9, field_tol=1e-10):
+    a, b = summary(ref), summary(run)
+    check(a["points"] == b["points"] and a["points_per_body"] == b["points_per_body"],
+          f"{label}: points {b['points_per_body']} = {a['points_per_body']}")
+    check(a["steps"] == b["steps"], f"{label}: steps {b['steps']} = {a['steps']}")
+    if "settling_velocity" in a:
+        va, vb = a["settling_velocity"], b["settling_velocity"]
+        rel = abs(vb - va) / abs(va)
+        check(rel <= settling_tol, f"{label}: settling_velocity {vb!r} vs {va!r}: relative {rel:.2e} <= {settling_tol:g}")
+    ra, rb = last_series_row(ref), last_series_row(run)
+    for key in ra:
+        if key.startswith("mass_"):
+            rel = abs(rb[key] - ra[key]) / ra[key]
+            check(rel <= 1e-13, f"{label}: {key} {rb[key]!r} vs {ra[key]!r}: relative {rel:.1e} (<= 1e-13: the "
+                                f"summation order)")
+    for body in [k[len("mass_"):] for k in ra if k.startswith("mass_")]:
+        pa = np.array([ra[k] for k in ra if k.startswith(f"momentum_{body}_")])
+        pb = np.array([rb[k] for k in rb if k.startswith(f"momentum_{body}_")])
+        scale = ra[f"mass_{body}"] * max(ra[f"max_speed_{body}"], 1e-300)  # |P| <= M max|v|
+        rel = np.abs(pb - pa).max() / scale
+        check(rel <= 1e-12, f"{label}: momentum of {body} within {rel:.1e} of M max|v| (<= 1e-12)")
+    fa, fb = final_frame(ref), final_frame(run)
+    for body in fa:
+        xa, xb = fa[body]["position"], fb[body]["position"]
+        idx = match(xa, xb)
+        check(len(np.unique(idx)) == len(xa), f"{label}: {body}: every point matched once")
+        check(np.array_equal(fb[body]["mass"], fa[body]["mass"][idx]), f"{label}: {body}: point masses bit for bit")
+        for k in ("position", "velocity", "stress", "volume"):
+            A, B = fa[body][k][idx], fb[body][k]
+            if k == "position":  # relative to the domain's size
+                scale = np.abs(xa).max()
+            else:
+                scale = max(np.abs(A).max(), 1e-300)
+            rel = np.abs(B - A).max() / scale
+            check(rel <= field_tol, f"{label}: {body} {k} after {a['steps']} steps: {rel:.1e} of its largest magnitude "
+                                    f"(<= {field_tol:g})")
+
+
+def case_settling_3d(work):
+    ref = run_ok(os.path.join(work, "s3d_np0"), SETTLING_3D, 0)
+    for ranks, threads, extra, name in [(1, 1, [], "np1"), (2, 1, [], "np2"), (3, 1, [], "np3"),
+                                        (2, 2, [], "np2_t2"), (2, 1, ["--ranks-grid", "1x1x2"], "np2_grid112")]:
+        run = run_ok(os.path.join(work, f"s3d_{name}"), SETTLING_3D, ranks, threads, extra)
+        if ranks > 1 and not failures:
+            s = summary(run)
+            check(s["ranks"] == ranks and "ranks_grid" in s and s["points_per_rank"]["max"] < s["points"],
+                  f"settling_3d {name}: summary has ranks {s['ranks']}, ranks_grid {s.get('ranks_grid')}, "
+                  f"points_per_rank {s.get('points_per_rank')}")
+        if not failures:
+            compare(ref, run, f"settling_3d {name}")
+
+
+def case_settling_2d(work):
+    ref = run_ok(os.path.join(work, "s2d_np0"), SETTLING_2D, 0)
+    for ranks, extra, name in [(2, [], "np2"), (3, [], "np3"), (3, ["--ranks-grid", "1x3"], "np3_grid13")]:
+        run = run_ok(os.path.join(work, f"s2d_{name}"), SETTLING_2D, ranks, 1, extra)
+        if not failures:
+            compare(ref, run, f"settling 2D {name}")
+
+
+def crossing(work, scene, runs):
+    name = os.path.splitext(os.path.basename(scene))[0]
+    ref = oobleck_plain(work, scene, name)
+    for ranks, threads, grid, crossing_expected in runs:
+        extra = ["--ranks-grid", grid] if grid else []
+        tag = f"np{ranks}_t{threads}" + (f"_{grid}" if grid else "")
+        out = os.path.join(work, f"{name}_{tag}")
+        shutil.rmtree(out, ignore_errors=True)
+        rc, err = oobleck([scene, "--out", out] + extra, ranks, threads)
+        check(rc == 0, f"{name} {tag}: exit status {rc}" + ("" if rc == 0 else f"\n{err[-2000:]}"))
+        if rc != 0:
+            continue
+        s = summary(out)
+        if crossing_expected:
+            check(s["points_migrated"] > s["points"] // 10,
+                  f"{name} {tag} ({s['ranks_grid']}): {s['points_migrated']} points crossed between ranks "
+                  f"(> a tenth of {s['points']})")
+        compare(ref, out, f"{name} {tag}")
+
+
+def oobleck_plain(work, scene, name):
+    out = os.path.join(work, f"{name}_np0")
+    shutil.rmtree(out, ignore_errors=True)
+    rc, err = oobleck([scene, "--out", out], 0)
+    check(rc == 0, f"{name}: one-rank run, exit status {rc}" + ("" if rc == 0 else f"\n{err[-2000:]}"))
+    return out
+
+
+def case_crossing_2d(work):
+    crossing(work, os.path.join(ROOT, "tests/mpi/crossing_2d.toml"),
+             [(2, 1, None, True), (3, 1, "3x1", True), (3, 1, "1x3", False), (2, 2, None, True)])
+
+
+def case_crossing_3d(work):
+    crossing(work, os.path.join(ROOT, "tests/mpi/crossing_3d.toml"),
+             [(2, 1, None, True), (3, 1, "3x1x1", True), (4, 1, "2x2x1", True), (2, 2, "1x2x1", True)])
+
+
+def case_restart(work):
+    """Write a checkpoint on 2 ranks, continue on 1 and on 3: the uninterrupted run's results."""
+    ref = run_ok(os.path.join(work, "r_full"), SETTLING_3D, 0)
+    half = run_ok(os.path.join(work, "r_half"), SETTLING_3D, 2, 1, ["--stop-after", "100"])
+    check(summary(half)["complete"] is False and os.path.exists(os.path.join(half, "checkpoint.h5")),
+          "restart: the 2-rank run stopped after 100 steps with a checkpoint")
+    for ranks in (1, 3):
+        d = os.path.join(work, f"r_on{ranks}")
+        shutil.rmtree(d, ignore_errors=True)
+        shutil.copytree(half, d)
+        rc, err = oobleck(["--restart", d], ranks)
+        check(rc == 0, f"restart on {ranks} rank(s): exit status {rc}" + ("" if rc == 0 else f"\n{err[-2000:]}"))
+        if rc == 0:
+            check(summary(d)["steps"] == summary(ref)["steps"], f"restart on {ranks}: ran to step {summary(ref)['steps']}")
+            compare(ref, d, f"restart 2 -> {ranks} ranks", settling_tol=1e-10)
+
+
+def expect_refused(work, name, args, ranks, message):
+    out = os.path.join(work, name)
+    shutil.rmtree(out, ignore_errors=True)
+    rc, err = oobleck([SETTLING_3D, "--out", out] + args, ranks)
+    check(rc != 0 and message in err, f"{name}: refused (status {rc}) with '{message}'" +
+          ("" if message in err else f"\n{err[-1500:]}"))
+    check(not os.path.exists(out), f"{name}: no run folder written")
+
+
+def case_bad_input(work):
+    expect_refused(work, "bad_grid_count", ["--ranks-grid", "3x1x1"], 2, "3 ranks in the grid, but the run has 2")
+    expect_refused(work, "bad_thin_block", ["--ranks-grid", "2x1x1"], 2, "a block needs at least 3 cells")
+    expect_refused(work, "bad_too_many_ranks", [], 7, "the grid (4x4x20 cells) is too small")
+    expect_refused(work, "bad_grid_one_rank", ["--ranks-grid", "1x1x2"], 0, "this run has 1 (start it with mpirun -np 2)")
+    expect_refused(work, "bad_grid_syntax", ["--ranks-grid", "2x"], 2, "expected 3 positive factors")
+    intrusion = os.path.join(ROOT, "scenes/paper/intrusion.toml")
+    out = os.path.join(work, "bad_third_body")
+    shutil.rmtree(out, ignore_errors=True)
+    rc, err = oobleck([intrusion, "--out", out], 2)
+    check(rc != 0 and "does not run decomposed yet" in err, f"bad_third_body: refused (status {rc})")
+    check(not os.path.exists(out), "bad_third_body: no run folder written")
+
+
+if __name__ == "__main__":
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--oobleck", required=True)
+    ap.add_argument("--case", required=True, choices=["settling_3d", "settling_2d", "crossing_2d", "crossing_3d", "restart",
+                                                      "bad_input"])
+    ap.add_argument("--work", required=True)
+    args = ap.parse_args()
+    BIN = os.path.abspath(args.oobleck)
+    os.makedirs(args.work, exist_ok=True)
+    globals()["case_" + args.case](args.work)
+    print(f"{len(failures)} failure(s)")
+    sys.exit(1 if failures else 0)
