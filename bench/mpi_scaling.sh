@@ -23,7 +23,7 @@ run() {  # run NAME RANKS [--set ...]
 }
 for r in $(seq 1 "$ROUNDS"); do
   run "strong.1.$r" 1
-  run "strong.2.$r" 2
+  run "strong.2.$r" 2 --ranks-grid 2x1x1  # (split across the motion: points migrate)
   echo "mpi_scaling: strong round $r of $ROUNDS done" >&2
 done
 for n in 1 2 4; do

@@ -39,7 +39,7 @@ TEST(Decomposition, BlocksCoverEveryCellOnce) {
       EXPECT_FALSE(local.periodic[1]);
       for (int i = 0; i < local.cells[0]; ++i)
         for (int j = 0; j < local.cells[1]; ++j)
-          ++covered[static_cast<std::size_t>((d.block_begin(0) + i) * g.cells[1] + d.block_begin(1) + j)];
+          ++covered.at(static_cast<std::size_t>(d.block_begin(0) + i) * g.cells[1] + d.block_begin(1) + j);
     }
     for (int c : covered) ASSERT_EQ(c, 1) << ranks << " ranks";
   }

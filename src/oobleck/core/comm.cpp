@@ -1,5 +1,6 @@
 #include "oobleck/core/comm.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <type_traits>
 #include <cstdlib>
@@ -47,9 +48,8 @@ bool built_with_mpi() {
 
 bool launched_by_mpirun() {
   // Open MPI (OMPI_COMM_WORLD_SIZE), PMIx launchers (PMIX_RANK), MPICH's Hydra (PMI_SIZE).
-  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_SIZE"})
-    if (std::getenv(v) != nullptr) return true;
-  return false;
+  const char* const vars[] = {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_SIZE"};
+  return std::ranges::any_of(vars, [](const char* v) { return std::getenv(v) != nullptr; });
 }
 
 void init([[maybe_unused]] int& argc, [[maybe_unused]] char**& argv) {

@@ -124,9 +124,8 @@ template <class G>
 void write_frame(io::FrameWriter* frames, const scene::BuiltScene<G>& scene) {
   auto& solver = *scene.solver;
   // Decomposed: every rank's points gathered onto rank 0 for the frame (mpm/halo.hpp), then back.
-  std::vector<std::int64_t> own;
-  if (solver.decomposition())
-    for (int b = 0; b < solver.body_count(); ++b) own.push_back(mpm::gather_points_to_root(solver.body(b)));
+  std::vector<std::int64_t> own(solver.decomposition() ? static_cast<std::size_t>(solver.body_count()) : 0);
+  for (std::size_t b = 0; b < own.size(); ++b) own[b] = mpm::gather_points_to_root(solver.body(static_cast<int>(b)));
   io::Frame frame;
   frame.time = solver.time_s();
   frame.step = solver.steps();

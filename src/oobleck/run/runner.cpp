@@ -236,8 +236,8 @@ mpm::FieldList SceneRun<G>::state_fields() {
 template <class G>
 void SceneRun<G>::write_checkpoint() {
   if (solver().decomposition()) {  // every rank's points onto rank 0, which writes them; then back
-    std::vector<std::int64_t> own;
-    for (int b = 0; b < solver().body_count(); ++b) own.push_back(mpm::gather_points_to_root(solver().body(b)));
+    std::vector<std::int64_t> own(static_cast<std::size_t>(solver().body_count()));
+    for (int b = 0; b < solver().body_count(); ++b) own[b] = mpm::gather_points_to_root(solver().body(b));
     if (comm::is_root()) write_checkpoint_file();
     for (int b = 0; b < solver().body_count(); ++b) solver().body(b).resize(own[static_cast<std::size_t>(b)]);
     return;
