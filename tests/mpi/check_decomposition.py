@@ -92,6 +92,10 @@ def compare(ref, run, label, settling_tol=1e-9, field_tol=1e-10):
         va, vb = a["settling_velocity"], b["settling_velocity"]
         rel = abs(vb - va) / abs(va)
         check(rel <= settling_tol, f"{label}: settling_velocity {vb!r} vs {va!r}: relative {rel:.2e} <= {settling_tol:g}")
+    for key in ("torque_inner", "torque_outer", "velocity_profile_rms_error"):
+        if key in a:
+            rel = abs(b[key] - a[key]) / abs(a[key])
+            check(rel <= 1e-10, f"{label}: {key} {b[key]!r} vs {a[key]!r}: relative {rel:.2e} <= 1e-10")
     ra, rb = last_series_row(ref), last_series_row(run)
     for key in ra:
         if key.startswith("mass_"):  # the same point masses (checked below) summed in another order
@@ -144,7 +148,7 @@ def case_settling_2d(work):
             compare(ref, run, f"settling 2D {name}")
 
 
-def crossing(work, scene, runs):
+def against_one_rank(work, scene, runs):
     name = os.path.splitext(os.path.basename(scene))[0]
     ref = oobleck_plain(work, scene, name)
     for ranks, threads, grid, crossing_expected in runs:
@@ -173,13 +177,20 @@ def oobleck_plain(work, scene, name):
 
 
 def case_crossing_2d(work):
-    crossing(work, os.path.join(ROOT, "tests/mpi/crossing_2d.toml"),
+    against_one_rank(work, os.path.join(ROOT, "tests/mpi/crossing_2d.toml"),
              [(2, 1, None, True), (3, 1, "3x1", True), (3, 1, "1x3", False), (2, 2, None, True)])
 
 
 def case_crossing_3d(work):
-    crossing(work, os.path.join(ROOT, "tests/mpi/crossing_3d.toml"),
+    against_one_rank(work, os.path.join(ROOT, "tests/mpi/crossing_3d.toml"),
              [(2, 1, None, True), (3, 1, "3x1x1", True), (4, 1, "2x2x1", True), (2, 2, "1x2x1", True)])
+
+
+def case_couette_axisym(work):
+    """V3, axisymmetric with swirl (a driven inner wall, the axis-free gap split radially and
+    axially), to its steady state (0.6 s, 30 000 steps)."""
+    against_one_rank(work, os.path.join(ROOT, "scenes/verification/couette_axisym.toml"),
+             [(2, 1, None, False), (3, 1, "3x1", False), (2, 1, "1x2", False)])
 
 
 def case_restart(work):
@@ -277,7 +288,7 @@ def case_bad_input(work):
 if __name__ == "__main__":
     ap = argparse.ArgumentParser()
     ap.add_argument("--oobleck", required=True)
-    ap.add_argument("--case", required=True, choices=["settling_3d", "settling_2d", "crossing_2d", "crossing_3d", "restart",
+    ap.add_argument("--case", required=True, choices=["settling_3d", "settling_2d", "crossing_2d", "crossing_3d", "couette_axisym", "restart",
                                                       "bad_input", "killed_rank"])
     ap.add_argument("--work", required=True)
     args = ap.parse_args()

@@ -125,7 +125,8 @@ void SceneRun<G>::check_decomposable() const {
     return;
   }
   const auto kind = cfg_.analysis.kind;
-  if (kind != scene::AnalysisKind::None && kind != scene::AnalysisKind::Settling)
+  if (kind != scene::AnalysisKind::None && kind != scene::AnalysisKind::Settling &&
+      kind != scene::AnalysisKind::Couette)
     throw InputError(
         fmt::format("{}: [analysis] kind = \"{}\" does not run decomposed yet (mpirun -np {}); run it on "
                     "one rank (threads: --threads)",
