@@ -28,6 +28,9 @@ SHORT = ["--set", "time.duration=0.0056", "--set", "analysis.average_from=0.001"
          "--set", "output.frame_interval=0.0028"]
 
 failures = []
+# Open MPI's shared-memory transport copies large messages with process_vm_readv (CMA), which
+# containers without ptrace permission refuse; plain copies work everywhere.
+MPI_ENV = dict(os.environ, OMPI_MCA_btl_vader_single_copy_mechanism="none")
 
 
 def check(ok, what):
@@ -41,7 +44,7 @@ def oobleck(args, ranks, threads=1, timeout=300):
     cmd = [BIN, "run"] + args + ["--threads", str(threads), "--quiet"]
     if ranks > 0:
         cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-np", str(ranks)] + cmd
-    p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=MPI_ENV)
     return p.returncode, p.stderr
 
 
@@ -225,7 +228,7 @@ def case_killed_rank(work):
     shutil.rmtree(d, ignore_errors=True)
     cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-np", "2", BIN, "run", scene, "--out", d,
            "--threads", "1", "--quiet"] + longer
-    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=MPI_ENV)
     victim = None
     deadline = time.time() + 120
     while time.time() < deadline and p.poll() is None:
