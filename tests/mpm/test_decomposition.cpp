@@ -45,6 +45,27 @@ TEST(Decomposition, BlocksCoverEveryCellOnce) {
   }
 }
 
+TEST(Decomposition, CutsBalanceTheLoad) {
+  const Grid<2> g = grid_2d();  // 40 x 20 cells
+  Decomposition<2>::Load load;
+  load[0].assign(40, 0.0);
+  load[1].assign(20, 0.0);
+  for (int c = 0; c < 10; ++c) load[0][c] = 3.0;  // three quarters of the load in the first 10 cells
+  for (int c = 10; c < 40; ++c) load[0][c] = 1.0 / 3.0;
+  for (int c = 0; c < 8; ++c) load[1][c] = 1.0;  // a bed 8 cells deep under 12 empty ones
+  const Decomposition<2> x(g, 2, 0, {2, 1}, load);
+  // half of 40: cell 6 2/3 of the dense run; the nearer cell face is 7
+  EXPECT_EQ(x.block_cells(0), 7);
+  const Decomposition<2> y(g, 2, 0, {1, 2}, load);
+  EXPECT_EQ(y.block_cells(1), 4);  // 4 + 4 layers of the bed
+  const Decomposition<2> y3(g, 3, 0, {1, 3}, load);
+  EXPECT_EQ(y3.block_cells(1), 3);  // 8/3 rounds to 3 = the fewest cells a block may have
+  const Decomposition<2> y3_last(g, 3, 2, {1, 3}, load);
+  EXPECT_EQ(y3_last.block_begin(1), 6);  // 16/3 = 5.3 → 5, kept 3 cells after the first cut
+  // Without a load: equal shares of the cells.
+  EXPECT_EQ(Decomposition<2>(g, 2, 0, {1, 2}).block_cells(1), 10);
+}
+
 TEST(Decomposition, OwnerOfAPositionIsTheBlockThatHoldsItsCell) {
   const Grid<2> g = grid_2d();
   const Decomposition<2> d(g, 6, 0, {3, 2});  // blocks of 13/13/14 x 10 cells

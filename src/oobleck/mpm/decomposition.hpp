@@ -64,10 +64,16 @@ std::array<int, D> parse_ranks_grid(const std::string& text, const std::string& 
 template <int D>
 class Decomposition {
  public:
+  /// Points per cell layer along each axis (load[a][c]: the points whose cell index along axis a
+  /// is c), for cuts that balance the points; empty: cuts that balance the cells.
+  using Load = std::array<std::vector<double>, D>;
+
   /// The layout of `ranks` ranks over `global`: `dims` given (all > 0, product = ranks) or chosen
-  /// (dims all 0: the split with the least block surface, i.e. the fewest ghost nodes). InputError
-  /// when the product differs from the rank count or a block would be thinner than kMinBlockCells.
-  Decomposition(const Grid<D>& global, int ranks, int rank, std::array<int, D> dims = {})
+  /// (dims all 0: the split with the least block surface, i.e. the fewest ghost nodes). Along each
+  /// split axis the cuts give every block about the same share of `load` (of the cells without
+  /// it), at least kMinBlockCells cells each. InputError when the product differs from the rank
+  /// count or a block would be thinner than kMinBlockCells.
+  Decomposition(const Grid<D>& global, int ranks, int rank, std::array<int, D> dims = {}, const Load& load = {})
       : global_(global), rank_(rank) {
     bool given = true;
     for (int a = 0; a < D; ++a) given = given && dims[a] > 0;
@@ -98,9 +104,7 @@ class Decomposition {
     const auto c = comm::cart_coords(dims_, rank_);
     for (int a = 0; a < D; ++a) {
       coords_[a] = c[a];
-      starts_[a].resize(static_cast<std::size_t>(dims_[a]) + 1);
-      for (int k = 0; k <= dims_[a]; ++k)
-        starts_[a][k] = static_cast<int>(static_cast<long>(global.cells[a]) * k / dims_[a]);
+      starts_[a] = cuts(global.cells[a], dims_[a], load[a]);
     }
   }
 
@@ -165,6 +169,28 @@ class Decomposition {
 
  private:
   int cart(const std::array<int, D>& c) const { return comm::cart_rank(dims_, c); }
+
+  /// Block starts along one axis of `cells` cells in `parts` blocks (parts + 1 values, 0 … cells):
+  /// block k starts at the first cell where the cumulative load reaches k/parts of the total,
+  /// kept kMinBlockCells apart; equal shares of the cells without a load.
+  static std::vector<int> cuts(int cells, int parts, const std::vector<double>& load) {
+    std::vector<int> s(static_cast<std::size_t>(parts) + 1);
+    for (int k = 0; k <= parts; ++k) s[k] = static_cast<int>(static_cast<long>(cells) * k / parts);
+    double total = 0.0;
+    for (double w : load) total += w;
+    if (parts == 1 || static_cast<int>(load.size()) != cells || !(total > 0.0)) return s;
+    double cum = 0.0;
+    int c = 0;
+    for (int k = 1; k < parts; ++k) {
+      const double target = total * k / parts;
+      while (c < cells && cum + load[c] <= target) cum += load[c++];
+      // the nearer of the two cell faces around the target
+      int cut = (c < cells && target - cum > cum + load[c] - target) ? c + 1 : c;
+      cut = std::clamp(cut, s[k - 1] + kMinBlockCells, cells - (parts - k) * kMinBlockCells);
+      s[k] = cut;
+    }
+    return s;
+  }
 
   /// The split of `ranks` with the fewest ghost nodes (the least block surface), among those whose
   /// blocks are at least kMinBlockCells thick along split axes; of equal ones, the one that splits

@@ -146,7 +146,19 @@ template <class G>
 mpm::Decomposition<G::dim> SceneRun<G>::layout() const {
   std::array<int, G::dim> dims{};
   if (!opt_.ranks_grid.empty()) dims = mpm::parse_ranks_grid<G::dim>(opt_.ranks_grid, "--ranks-grid");
-  return mpm::Decomposition<G::dim>(solver().grid(), comm::size(), comm::rank(), dims);
+  // Points per cell layer along each axis, over every body (each rank holds the whole scene
+  // here): the cuts balance the points, not the cells (a bed under empty space).
+  constexpr int D = G::dim;
+  const auto& grid = solver().grid();
+  typename mpm::Decomposition<D>::Load load;
+  for (int a = 0; a < D; ++a) load[a].assign(static_cast<std::size_t>(grid.cells[a]), 0.0);
+  for (int b = 0; b < solver().body_count(); ++b)
+    for (const auto& x : solver().body(b).x_m)
+      for (int a = 0; a < D; ++a) {
+        const double r = (grid.wrapped(a, x[a]) - grid.origin_m[a]) / grid.h_m;
+        load[a][static_cast<std::size_t>(std::clamp(static_cast<int>(std::floor(r)), 0, grid.cells[a] - 1))] += 1.0;
+      }
+  return mpm::Decomposition<D>(grid, comm::size(), comm::rank(), dims, load);
 }
 
 /// Several ranks: keep this rank's block of the scene that every rank built (or restored).
