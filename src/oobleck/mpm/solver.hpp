@@ -252,7 +252,8 @@ class Solver {
   void decompose(const Decomposition<D>& dec) {
     if (dec_) throw InputError("mpm: the solver is already decomposed");
     for (int b = 0; b < body_count(); ++b)
-      if (rigid_[b].rigid() || !contacts_.empty() || !motors_.empty())
+      if (rigid_[b].rigid() || std::any_of(contacts_.begin(), contacts_.end(), [b](auto& c) { return c.solid == b; }) ||
+          std::any_of(motors_.begin(), motors_.end(), [b](auto& m) { return m.body == b; }))
         throw InputError(
             fmt::format("mpm: a decomposed run (mpirun -np {}) does not support third bodies yet (body '{}': "
                         "rigid bodies, contact and motors run on one rank)",

@@ -11,7 +11,6 @@
 
 #include "oobleck/core/comm.hpp"
 #include "oobleck/mpm/fields.hpp"
-#include "oobleck/mpm/halo.hpp"
 #include "oobleck/run/nodal_fields.hpp"
 
 namespace oobleck::run {
@@ -123,18 +122,18 @@ std::optional<io::NodeGrid> node_grid(const scene::BuiltScene<G>& scene, Columns
 template <class G>
 void write_frame(io::FrameWriter* frames, const scene::BuiltScene<G>& scene) {
   auto& solver = *scene.solver;
-  // Decomposed: every rank's points gathered onto rank 0 for the frame (mpm/halo.hpp), then back.
-  std::vector<std::int64_t> own(solver.decomposition() ? static_cast<std::size_t>(solver.body_count()) : 0);
-  for (std::size_t b = 0; b < own.size(); ++b) own[b] = mpm::gather_points_to_root(solver.body(static_cast<int>(b)));
-  io::Frame frame;
-  frame.time = solver.time_s();
-  frame.step = solver.steps();
-  Columns column(64 * static_cast<std::size_t>(solver.body_count()) + 16);
-  if (frames != nullptr)
-    for (int b = 0; b < solver.body_count(); ++b) frame.bodies.push_back(body_cloud(scene, b, column));
-  if (auto grid = node_grid(scene, column)) frame.grid = std::move(*grid);
-  for (std::size_t b = 0; b < own.size(); ++b) solver.body(static_cast<int>(b)).resize(own[b]);
-  if (frames != nullptr) frames->write(frame);
+  // (decomposed: rank 0 writes every rank's points; the frame views the bodies' arrays, so it is
+  // written before they shrink back)
+  with_every_point_on_root(solver, [&] {
+    io::Frame frame;
+    frame.time = solver.time_s();
+    frame.step = solver.steps();
+    Columns column(64 * static_cast<std::size_t>(solver.body_count()) + 16);
+    if (frames != nullptr)
+      for (int b = 0; b < solver.body_count(); ++b) frame.bodies.push_back(body_cloud(scene, b, column));
+    if (auto grid = node_grid(scene, column)) frame.grid = std::move(*grid);
+    if (frames != nullptr) frames->write(frame);
+  });
 }
 
 template <class G>

@@ -6,9 +6,25 @@
 #include <vector>
 
 #include "oobleck/io/frames.hpp"
+#include "oobleck/mpm/halo.hpp"
 #include "oobleck/scene/build.hpp"
 
 namespace oobleck::run {
+
+/// f() on every rank while rank 0's bodies hold every rank's points (appended in rank order,
+/// mpm/halo.hpp) and the other ranks' their own; afterwards each body holds only its own again.
+/// For what rank 0 writes of the whole run (frames, checkpoints). One rank: f().
+template <class G, class F>
+void with_every_point_on_root(mpm::Solver<G>& solver, F&& f) {
+  if (!solver.decomposition()) {
+    f();
+    return;
+  }
+  std::vector<std::int64_t> own(static_cast<std::size_t>(solver.body_count()));
+  for (std::size_t b = 0; b < own.size(); ++b) own[b] = mpm::gather_points_to_root(solver.body(static_cast<int>(b)));
+  f();
+  for (std::size_t b = 0; b < own.size(); ++b) solver.body(static_cast<int>(b)).resize(own[b]);
+}
 
 /// Write one frame: per body its points' position, velocity, stress, pressure (fluid_pressure for
 /// the fluid), mass and volume; the grains' f, phi, tau_bar, regime, gamma_dot_p; the fluid's phi

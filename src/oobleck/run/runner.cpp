@@ -15,7 +15,6 @@
 #include "oobleck/core/error.hpp"
 #include "oobleck/io/checkpoint.hpp"
 #include "oobleck/mpm/decomposition.hpp"
-#include "oobleck/mpm/halo.hpp"
 #include "oobleck/io/frames.hpp"
 #include "oobleck/io/output_file.hpp"
 #include "oobleck/io/progress.hpp"
@@ -94,7 +93,6 @@ class SceneRun {
   /// Everything a restart needs (run/checkpoint_state.hpp): solver, snapshots, analysis.
   mpm::FieldList state_fields();
   void write_checkpoint();
-  void write_checkpoint_file();
   void restore(const io::Checkpoint& cp);
   nlohmann::json summary(long steps_run, bool complete, double wall_s) const;
 
@@ -248,26 +246,17 @@ mpm::FieldList SceneRun<G>::state_fields() {
 
 template <class G>
 void SceneRun<G>::write_checkpoint() {
-  if (solver().decomposition()) {  // every rank's points onto rank 0, which writes them; then back
-    std::vector<std::int64_t> own(static_cast<std::size_t>(solver().body_count()));
-    for (int b = 0; b < solver().body_count(); ++b) own[b] = mpm::gather_points_to_root(solver().body(b));
-    if (comm::is_root()) write_checkpoint_file();
-    for (int b = 0; b < solver().body_count(); ++b) solver().body(b).resize(own[static_cast<std::size_t>(b)]);
-    return;
-  }
-  write_checkpoint_file();
-}
-
-template <class G>
-void SceneRun<G>::write_checkpoint_file() {
-  io::CheckpointWriter cp(checkpoint_path(opt_.out_dir));
-  cp.set_step(solver().steps());
-  cp.set_time(solver().time_s());
-  cp.set_config(cfg_.resolved_toml);
-  cp.attribute("dt", scene_.dt_s);
-  cp.attribute("threads", static_cast<std::int64_t>(solver().threads()));
-  save_fields(cp, state_fields());
-  cp.commit();
+  with_every_point_on_root(solver(), [&] {  // (decomposed: rank 0 writes every rank's points)
+    if (!comm::is_root()) return;
+    io::CheckpointWriter cp(checkpoint_path(opt_.out_dir));
+    cp.set_step(solver().steps());
+    cp.set_time(solver().time_s());
+    cp.set_config(cfg_.resolved_toml);
+    cp.attribute("dt", scene_.dt_s);
+    cp.attribute("threads", static_cast<std::int64_t>(solver().threads()));
+    save_fields(cp, state_fields());
+    cp.commit();
+  });
 }
 
 template <class G>
