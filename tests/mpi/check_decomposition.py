@@ -99,7 +99,26 @@ def compare(ref, run, label, settling_tol=1e-9, field_tol=1e-10):
         if key in a:
             rel = abs(b[key] - a[key]) / abs(a[key])
             check(rel <= 1e-10, f"{label}: {key} {b[key]!r} vs {a[key]!r}: relative {rel:.2e} <= 1e-10")
+    for key in ("final_depth", "final_velocity", "hub_height_final", "distance"):
+        if key in a:
+            rel = abs(b[key] - a[key]) / max(abs(a[key]), 1e-300)
+            check(rel <= field_tol, f"{label}: {key} {b[key]!r} vs {a[key]!r}: relative {rel:.2e} <= {field_tol:g}")
     ra, rb = last_series_row(ref), last_series_row(run)
+    # Third bodies: centre (relative to the domain), contact force (relative to its largest
+    # component), motor ω and torque, at the last row.
+    groups = {}
+    for key in ra:
+        for prefix in ("centre_", "contact_force_", "omega_", "motor_torque_"):
+            if key.startswith(prefix):
+                groups.setdefault(key.rsplit("_", 1)[0] if prefix in ("centre_", "contact_force_") else key, []).append(key)
+    for group, keys in groups.items():
+        A, B = np.array([ra[k] for k in keys]), np.array([rb[k] for k in keys])
+        scale = max(np.abs(A).max(), 1e-300)
+        if group.startswith("centre_"):
+            scale = max(scale, 1e-3)
+        rel = np.abs(B - A).max() / scale
+        check(rel <= field_tol, f"{label}: {group} {B.tolist()} vs {A.tolist()}: {rel:.1e} of its largest magnitude "
+                                f"(<= {field_tol:g})")
     for key in ra:
         if key.startswith("mass_"):  # the same point masses (checked below) summed in another order
             n = a["points_per_body"][key[len("mass_"):]]
@@ -196,6 +215,57 @@ def case_couette_axisym(work):
              [(2, 1, None, False), (3, 1, "3x1", False), (2, 1, "1x2", False)])
 
 
+# The paper's scenes with third bodies, coarse and short (a few hundred steps, no snapshots).
+THIRD_BODY_SCENES = {
+    # S3: the prescribed intruder (axisymmetric), 1 mm, 200 steps; its fronts' fields sampled twice.
+    "intrusion": ("scenes/paper/intrusion.toml", ["--set", "duration=0.0002", "--set", "analysis.snapshot_times=[]",
+                                                  "--set", "output.frame_interval=0.0001"]),
+    # S2: the free rod (axisymmetric), 4 mm cells, 300 steps.
+    "rod": ("scenes/paper/rod_impact.toml", ["--set", "cell_size=0.004", "--set", "duration=0.0012",
+                                             "--set", "analysis.snapshot_times=[]",
+                                             "--set", "output.frame_interval=0.0006"]),
+    # S4: the elastic wheel with its motor (plane strain, periodic track), 60 x 30 cells, 400 steps.
+    "wheel": ("scenes/paper/wheel.toml", ["--set", "cells=[60, 30]", "--set", "duration=0.008",
+                                          "--set", "analysis.snapshot_times=[]", "--set", "output.frame_interval=0.004",
+                                          "--set", "analysis.sample_interval=0.002"]),
+}
+
+
+def case_third_bodies(work, name, runs):
+    scene, extra = THIRD_BODY_SCENES[name]
+    scene = os.path.join(ROOT, scene)
+    ref = os.path.join(work, f"{name}_np0")
+    shutil.rmtree(ref, ignore_errors=True)
+    rc, err = oobleck([scene, "--out", ref] + extra, 0)
+    check(rc == 0, f"{name}: one-rank run, exit status {rc}" + ("" if rc == 0 else f"\n{err[-2000:]}"))
+    for ranks, threads, grid in runs:
+        tag = f"np{ranks}_t{threads}" + (f"_{grid}" if grid else "")
+        out = os.path.join(work, f"{name}_{tag}")
+        shutil.rmtree(out, ignore_errors=True)
+        rc, err = oobleck([scene, "--out", out] + extra + (["--ranks-grid", grid] if grid else []), ranks, threads)
+        check(rc == 0, f"{name} {tag}: exit status {rc}" + ("" if rc == 0 else f"\n{err[-2000:]}"))
+        if rc == 0 and not failures:
+            compare(ref, out, f"{name} {tag}")
+            a, b = summary(ref), summary(out)
+            for body, pa in a.get("bodies", {}).items():
+                pb = b["bodies"][body]
+                check(pa["points"] == pb["points"] and
+                      abs(pb["mass"] - pa["mass"]) <= pa["points"] * 2.2e-16 * pa["mass"],
+                      f"{name} {tag}: body {body}: points {pb['points']}, mass {pb['mass']!r} vs {pa['mass']!r}")
+
+
+def case_intrusion(work):
+    case_third_bodies(work, "intrusion", [(2, 1, "2x1"), (3, 1, "1x3"), (2, 2, "1x2")])
+
+
+def case_rod(work):
+    case_third_bodies(work, "rod", [(2, 1, "1x2"), (3, 1, "3x1"), (2, 2, "2x1")])
+
+
+def case_wheel(work):
+    case_third_bodies(work, "wheel", [(2, 1, "2x1"), (3, 1, "3x1"), (2, 2, "1x2")])
+
+
 def case_restart(work):
     """Write a checkpoint on 2 ranks, continue on 1 and on 3: the uninterrupted run's results."""
     ref = run_ok(os.path.join(work, "r_full"), SETTLING_3D, 0)
@@ -280,19 +350,19 @@ def case_bad_input(work):
     expect_refused(work, "bad_too_many_ranks", [], 7, "the grid (4x4x20 cells) is too small")
     expect_refused(work, "bad_grid_one_rank", ["--ranks-grid", "1x1x2"], 0, "this run has 1 (start it with mpirun -np 2)")
     expect_refused(work, "bad_grid_syntax", ["--ranks-grid", "2x"], 2, "expected 3 positive factors")
-    intrusion = os.path.join(ROOT, "scenes/paper/intrusion.toml")
-    out = os.path.join(work, "bad_third_body")
+    annular = os.path.join(ROOT, "scenes/paper/annular_shear.toml")
+    out = os.path.join(work, "bad_annular")
     shutil.rmtree(out, ignore_errors=True)
-    rc, err = oobleck([intrusion, "--out", out], 2)
-    check(rc != 0 and "does not run decomposed yet" in err, f"bad_third_body: refused (status {rc})")
-    check(not os.path.exists(out), "bad_third_body: no run folder written")
+    rc, err = oobleck([annular, "--out", out], 2)
+    check(rc != 0 and "does not run decomposed yet" in err, f"bad_annular: refused (status {rc})")
+    check(not os.path.exists(out), "bad_annular: no run folder written")
 
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser()
     ap.add_argument("--oobleck", required=True)
     ap.add_argument("--case", required=True, choices=["settling_3d", "settling_2d", "crossing_2d", "crossing_3d", "couette_axisym", "restart",
-                                                      "bad_input", "killed_rank"])
+                                                      "bad_input", "killed_rank", "intrusion", "rod", "wheel"])
     ap.add_argument("--work", required=True)
     args = ap.parse_args()
     BIN = os.path.abspath(args.oobleck)

@@ -110,6 +110,33 @@ void sum([[maybe_unused]] std::span<std::int64_t> values) {
 #endif
 }
 
+void sum_ordered(std::span<double> values) {
+#ifdef OOBLECK_HAVE_MPI
+  if (!active() || values.empty()) return;
+  Timed t;
+  const int n = static_cast<int>(values.size());
+  std::vector<double> all(values.size() * static_cast<std::size_t>(size()));
+  MPI_Allgather(values.data(), n, MPI_DOUBLE, all.data(), n, MPI_DOUBLE, MPI_COMM_WORLD);
+  std::fill(values.begin(), values.end(), 0.0);
+  for (std::size_t r = 0; r < all.size(); r += values.size())
+    for (std::size_t k = 0; k < values.size(); ++k) values[k] += all[r + k];
+#endif
+}
+
+namespace {
+void reduce_extreme([[maybe_unused]] std::span<double> values, [[maybe_unused]] bool minimum) {
+#ifdef OOBLECK_HAVE_MPI
+  if (!active() || values.empty()) return;
+  Timed t;
+  MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, minimum ? MPI_MIN : MPI_MAX,
+                MPI_COMM_WORLD);
+#endif
+}
+}  // namespace
+
+void min(std::span<double> values) { reduce_extreme(values, true); }
+void max(std::span<double> values) { reduce_extreme(values, false); }
+
 double sum(double value) {
   sum(std::span<double>(&value, 1));
   return value;

@@ -31,8 +31,15 @@ int size();
 /// This process writes the run's files and prints its messages (rank 0).
 inline bool is_root() { return rank() == 0; }
 
-/// Allreduce sums in place (every rank gets the sums, added in rank order).
+/// Allreduce sums in place (MPI_Allreduce: the order of the additions is the library's).
 void sum(std::span<double> values);
+/// Sums in place that are bit for bit the same on every rank: every rank's values gathered
+/// (MPI_Allgather) and added in rank order on each. For the few numbers that feed state every
+/// rank holds a copy of (a rigid body's velocity, a motor's correction); P × values.size() doubles.
+void sum_ordered(std::span<double> values);
+/// Element-wise minimum / maximum over the ranks, in place (exact).
+void min(std::span<double> values);
+void max(std::span<double> values);
 void sum(std::span<std::int64_t> values);
 double sum(double value);
 std::int64_t sum(std::int64_t value);

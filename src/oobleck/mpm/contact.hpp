@@ -43,6 +43,13 @@
 //
 // Free functions over arrays; the Solver (solver.hpp) calls them in its grid pass. No allocation
 // inside a step (the nodal mass-gradient buffer is sized once).
+//
+// Decomposed runs (docs/mpi.md): every rank holds each rigid body's motion and each pair's sums,
+// and sees the points of its block only. The whole-body sums (mass, the motor's moments, the
+// rigid contact's normal system, the impulses) are this rank's share, completed with
+// comm::sum_ordered (`across_ranks`), which gives every rank the same bits, so the ranks advance
+// the bodies identically. The node sums count owned nodes only (the node weights are 0 on the
+// ghost nodes that another rank owns); the positions are compared on the global grid.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -51,6 +58,7 @@
 #include <vector>
 #include <Eigen/LU>
 
+#include "oobleck/core/comm.hpp"
 #include "oobleck/mpm/body.hpp"
 #include "oobleck/mpm/boundary.hpp"
 #include "oobleck/mpm/fields.hpp"
@@ -84,10 +92,13 @@ struct RigidMotion {
 /// The cells of a translating rigid body's point lattice in its own frame, relative to its first
 /// point: cell c holds a point at x_0 + c dx (dx the lattice spacing, (V_p/measure(x_p, 1))^(1/D)
 /// of its smallest point). A rigid body only translates, so its cells never change; they are
-/// built from the points at the first use (after a restart, from the restored points).
+/// built from the points at the first use (after a restart, from the restored points; decomposed
+/// runs: before the points are split over the ranks). The anchor x_0 moves with the body
+/// (move_anchor), so a rank without points of the body still knows where it is.
 template <int D>
 struct RigidShape {
   bool built = false;
+  Vec<D> anchor_m = Vec<D>::Zero();     ///< x_0, the first point's position (moved with the body)
   double dx_m = 0.0;                    ///< lattice spacing
   std::array<int, D> lo{}, n{};         ///< cell index range: lo .. lo + n − 1 per axis
   std::vector<unsigned char> occupied;  ///< 1 where a point of the body sits, row-major over n
@@ -167,47 +178,65 @@ Vec<D> periodic_difference(const Grid<D>& grid, const Vec<D>& x, const Vec<D>& x
   return d;
 }
 
-/// Mean angular velocity, centre and inertia of a plane body (see Motor), positions unwrapped
-/// about the first point on periodic axes.
+/// A position for the minimum-image differences of a body's points (periodic axes): its first
+/// point; `across_ranks`: along each axis the least of the ranks' first points' coordinates (a
+/// coordinate of one of its points: the same reference on every rank). Not finite when the body
+/// has no points.
 template <class G>
-void angular_state(const Body<G>& body, const Grid<G::dim>& grid, double& omega, double& inertia, Vec<G::dim>& centre,
-                   Vec<G::ncomp>& velocity) {
+Vec<G::dim> body_reference(const Body<G>& body, bool across_ranks) {
+  Vec<G::dim> x0 = body.size() > 0 ? body.x_m[0] : Vec<G::dim>::Constant(INFINITY);
+  if (across_ranks) comm::min({x0.data(), static_cast<std::size_t>(G::dim)});
+  return x0;
+}
+
+/// Mean angular velocity, centre and inertia of a plane body (see Motor), positions unwrapped
+/// about body_reference on periodic axes (`grid`: the global grid); sums over every rank's points
+/// when `across_ranks`.
+template <class G>
+void angular_state(const Body<G>& body, const Grid<G::dim>& grid, bool across_ranks, double& omega, double& inertia,
+                   Vec<G::dim>& centre, Vec<G::ncomp>& velocity) {
   static_assert(G::dim == 2 && G::ncomp == 2, "angular_state: plane strain only");
   const std::int64_t np = body.size();
   omega = inertia = 0.0;
   centre.setZero();
   velocity.setZero();
-  if (np == 0) return;
-  const Vec<2> x0 = body.x_m[0];
-  double M = 0.0;
-  Vec<2> sx = Vec<2>::Zero();
+  const Vec<2> x0 = body_reference(body, across_ranks);
+  if (!std::isfinite(x0[0])) return;            // no points
+  double first[5] = {0.0, 0.0, 0.0, 0.0, 0.0};  // M, Σ m (x − x0), Σ m v
   for (std::int64_t p = 0; p < np; ++p) {
     const double m = body.mass_kg[p];
-    M += m;
-    sx += m * periodic_difference<2>(grid, body.x_m[p], x0);
-    velocity += m * body.v_m_s[p];
+    const Vec<2> d = m * periodic_difference<2>(grid, body.x_m[p], x0), mv = m * body.v_m_s[p];
+    first[0] += m;
+    first[1] += d[0];
+    first[2] += d[1];
+    first[3] += mv[0];
+    first[4] += mv[1];
   }
-  const Vec<2> dc = sx / M;
-  velocity /= M;
-  double Lz = 0.0;
+  if (across_ranks) comm::sum_ordered(first);
+  const double M = first[0];
+  const Vec<2> dc = Vec<2>(first[1], first[2]) / M;
+  velocity = Vec<2>(first[3], first[4]) / M;
+  double second[2] = {0.0, 0.0};  // Σ m r × u, Σ m |r|²
   for (std::int64_t p = 0; p < np; ++p) {
     const double m = body.mass_kg[p];
     const Vec<2> r = periodic_difference<2>(grid, body.x_m[p], x0) - dc;
     const Vec<2> u = body.v_m_s[p] - velocity;
-    Lz += m * (r[0] * u[1] - r[1] * u[0]);
-    inertia += m * r.squaredNorm();
+    second[0] += m * (r[0] * u[1] - r[1] * u[0]);
+    second[1] += m * r.squaredNorm();
   }
-  omega = inertia > 0.0 ? Lz / inertia : 0.0;
+  if (across_ranks) comm::sum_ordered(second);
+  inertia = second[1];
+  omega = inertia > 0.0 ? second[0] / inertia : 0.0;
   centre = x0 + dc;
   grid.wrap(centre);
 }
 
-/// Apply one motor correction (see Motor) to its body before the step.
+/// Apply one motor correction (see Motor) to its body before the step (`grid`: the global grid).
 template <class G>
-void apply_motor(Motor<G>& motor, Body<G>& body, const Grid<G::dim>& grid, double dt_s) {
+void apply_motor(Motor<G>& motor, Body<G>& body, const Grid<G::dim>& grid, bool across_ranks, double dt_s) {
   Vec<2> centre, V;
   double omega = 0.0, inertia = 0.0;
-  angular_state(body, grid, omega, inertia, centre, V);
+  angular_state(body, grid, across_ranks, omega, inertia, centre, V);
   const double dw = motor.gain * (motor.omega_rad_s - omega);
   const std::int64_t np = body.size();
   Mat<2, 2> dC;
@@ -223,14 +252,10 @@ void apply_motor(Motor<G>& motor, Body<G>& body, const Grid<G::dim>& grid, doubl
   motor.torque_N_m = inertia * dw / dt_s;
 }
 
-/// Total mass and predicted velocity of a rigid body; its nodal velocity (and v_old) set to the
-/// rigid velocity on every node with mass (model.md §8).
+/// Predicted velocity of a rigid body (its mass rm.mass_kg set by the caller, over every rank);
+/// its nodal velocity (and v_old) set to the rigid velocity on every node with mass (model.md §8).
 template <class G>
-void predict_rigid(RigidMotion<G>& rm, const Body<G>& body, GridField<G>& field, const Vec<G::ncomp>& gravity,
-                   double dt_s) {
-  double M = 0.0;
-  for (double m : body.mass_kg) M += m;
-  rm.mass_kg = M;
+void predict_rigid(RigidMotion<G>& rm, GridField<G>& field, const Vec<G::ncomp>& gravity, double dt_s) {
   rm.predicted_m_s = rm.velocity_m_s;
   if (rm.kind == BodyMotion::FreeRigid) rm.predicted_m_s += dt_s * gravity.cwiseProduct(rm.free_mask);
   const int nn = field.nodes();
@@ -387,6 +412,27 @@ std::vector<double> contact_node_weights(const Grid<D>& grid, const BoundaryCond
 }
 }  // namespace detail
 
+/// A pair's sums of the step (its share of the nodes on this rank; `across_ranks`: completed over
+/// every rank with the same bits on each) into its outputs.
+template <class G>
+Vec<G::ncomp> finish_pair_sums(ContactPair<G>& pair, const Vec<G::ncomp>& J_body, const Vec<G::ncomp>& J_grains,
+                               int active, bool across_ranks, double dt_s) {
+  constexpr int NC = G::ncomp;
+  double sums[2 * NC + 1];
+  for (int k = 0; k < NC; ++k) {
+    sums[k] = J_body[k];
+    sums[NC + k] = J_grains[k];
+  }
+  sums[2 * NC] = active;
+  if (across_ranks) comm::sum_ordered(sums);
+  const Vec<NC> J = Eigen::Map<const Vec<NC>>(sums), Jg = Eigen::Map<const Vec<NC>>(sums + NC);
+  pair.active_nodes = static_cast<int>(sums[2 * NC]);
+  pair.force_N = J / dt_s;
+  pair.force_on_grains_N = Jg / dt_s;
+  pair.impulse_sum_N_s += J;
+  return J;
+}
+
 /// Volume of node i's control volume h^D (per radian: h² r_i) for the overlap test.
 template <class G>
 double node_measure(const Grid<G::dim>& grid, int i) {
@@ -396,12 +442,12 @@ double node_measure(const Grid<G::dim>& grid, int i) {
 /// Resolve one contact pair at every node (model.md §8): impulses applied to the nodal velocities
 /// of the grains, the fluid and a deformable solid (a rigid one only accumulates them), summed
 /// with the node weights into pair.force_N. Serial over nodes (deterministic sums; the solid
-/// occupies few nodes). Returns the total impulse on the solid.
+/// occupies few nodes). Returns the total impulse on the solid (over every rank: across_ranks).
 template <class G>
 Vec<G::ncomp> resolve_contact(ContactPair<G>& pair, const RigidMotion<G>& rm, GridField<G>& solid, GridField<G>* grains,
                               GridField<G>* fluid, const std::vector<double>& weight, const double* mixture_volume,
                               const std::vector<double>& node_volume, const Vec<G::dim>* mixture_gradient,
-                              double dt_s) {
+                              bool across_ranks, double dt_s) {
   constexpr int NC = G::ncomp, D = G::dim;
   Vec<NC> J_body = Vec<NC>::Zero(), J_grains = Vec<NC>::Zero();
   int active = 0;
@@ -434,11 +480,7 @@ Vec<G::ncomp> resolve_contact(ContactPair<G>& pair, const RigidMotion<G>& rm, Gr
     J_body -= weight[i] * (Js + Jf);
     J_grains += weight[i] * Js;
   }
-  pair.active_nodes = active;
-  pair.force_N = J_body / dt_s;
-  pair.force_on_grains_N = J_grains / dt_s;
-  pair.impulse_sum_N_s += J_body;
-  return J_body;
+  return finish_pair_sums(pair, J_body, J_grains, active, across_ranks, dt_s);
 }
 
 /// Contact of a *free rigid* body with the mixture, solved for the body as a whole (model.md §8 in
@@ -452,11 +494,13 @@ Vec<G::ncomp> resolve_contact(ContactPair<G>& pair, const RigidMotion<G>& rm, Gr
 /// (≤ 20 passes; it settles in 1–3). Then Coulomb friction on the grains with the body as the
 /// infinite-mass partner, J_t = min(μ J_n, m_s |w_t|), its reaction summed into V. Momentum is
 /// conserved exactly (each phase impulse is matched by the body's). Returns the body impulse.
+/// `across_ranks`: the node sums of the system and of the impulses over every rank (each rank's
+/// owned nodes), so that every rank solves the same system and gets the same V.
 template <class G>
 Vec<G::ncomp> resolve_rigid_contact(ContactPair<G>& pair, RigidMotion<G>& rm, const GridField<G>& solid,
                                     GridField<G>* grains, GridField<G>* fluid, const std::vector<double>& weight,
                                     const double* mixture_volume, const std::vector<double>& node_volume,
-                                    const Vec<G::dim>* mixture_gradient, double dt_s) {
+                                    const Vec<G::dim>* mixture_gradient, bool across_ranks, double dt_s) {
   constexpr int NC = G::ncomp, D = G::dim;
   const int nn = solid.nodes();
   const double M = rm.mass_kg;
@@ -479,8 +523,9 @@ Vec<G::ncomp> resolve_rigid_contact(ContactPair<G>& pair, RigidMotion<G>& rm, co
   // Active-set iteration for V.
   Vec<NC> V = Vstar;
   for (int it = 0; it < 20; ++it) {
-    Mat<NC, NC> A = M * Mat<NC, NC>::Identity();
-    Vec<NC> b = M * Vstar;
+    // (across ranks: the nodes' terms alone first, summed over the ranks, then the body's)
+    Mat<NC, NC> A = across_ranks ? Mat<NC, NC>::Zero() : Mat<NC, NC>(M * Mat<NC, NC>::Identity());
+    Vec<NC> b = across_ranks ? Vec<NC>::Zero() : Vec<NC>(M * Vstar);
     for (int i = 0; i < nn; ++i) {
       Vec<NC> n;
       if (!normal_at(i, n)) continue;
@@ -493,6 +538,16 @@ Vec<G::ncomp> resolve_rigid_contact(ContactPair<G>& pair, RigidMotion<G>& rm, co
         A += wm * (n * n.transpose());
         b += (wm * vkn) * n;
       }
+    }
+    if (across_ranks) {
+      double sums[NC * NC + NC];
+      Eigen::Map<Mat<NC, NC>> sum_A(sums);
+      Eigen::Map<Vec<NC>> sum_b(sums + NC * NC);
+      sum_A = A;
+      sum_b = b;
+      comm::sum_ordered(sums);
+      A = M * Mat<NC, NC>::Identity() + sum_A;
+      b = M * Vstar + sum_b;
     }
     for (int c = 0; c < NC; ++c) {  // held components: V_c = V*_c
       if (rm.free_mask[c] != 0.0) continue;
@@ -534,11 +589,7 @@ Vec<G::ncomp> resolve_rigid_contact(ContactPair<G>& pair, RigidMotion<G>& rm, co
     }
     active += touched ? 1 : 0;
   }
-  pair.active_nodes = active;
-  pair.force_N = J_body / dt_s;
-  pair.force_on_grains_N = J_grains / dt_s;
-  pair.impulse_sum_N_s += J_body;
-  return J_body;
+  return finish_pair_sums(pair, J_body, J_grains, active, across_ranks, dt_s);
 }
 
 /// Lattice spacing of a point of a lattice body, (V_p/measure(x_p, 1))^(1/D) (plane: √V_p;
@@ -562,6 +613,7 @@ void build_rigid_shape(RigidShape<G::dim>& shape, const Body<G>& body, const Gri
   }
   if (!std::isfinite(dx)) return;  // no points: nothing to keep out
   shape.dx_m = dx;
+  shape.anchor_m = body.x_m[0];
   std::vector<std::array<int, D>> cells(static_cast<std::size_t>(np));
   std::array<int, D> hi{};
   for (int a = 0; a < D; ++a) {
@@ -597,12 +649,13 @@ void build_rigid_shape(RigidShape<G::dim>& shape, const Body<G>& body, const Gri
 /// (velocity, volume and stress are the point's): no momentum is exchanged. Nodal contact
 /// constrains nodal velocities only, so points near the surface, which interpolate from nodes in
 /// and out of contact, and points carried by noise in the mixture, enter a rigid body and stay
-/// there, adding their weight to it. Returns the number of points moved.
+/// there, adding their weight to it. Returns the number of points moved. `grid`: the global grid
+/// (a decomposed run's points move across its blocks; the migration follows).
 template <class G>
-int keep_points_out(const RigidShape<G::dim>& shape, const Body<G>& rigid, Body<G>& mix, const Grid<G::dim>& grid) {
+int keep_points_out(const RigidShape<G::dim>& shape, Body<G>& mix, const Grid<G::dim>& grid) {
   constexpr int D = G::dim;
-  if (shape.occupied.empty() || rigid.size() == 0) return 0;
-  const Vec<D> x0 = rigid.x_m[0];
+  if (shape.occupied.empty()) return 0;
+  const Vec<D> x0 = shape.anchor_m;
   const double dx = shape.dx_m;
   int moved = 0;
   const std::int64_t np = mix.size();
@@ -640,6 +693,15 @@ int keep_points_out(const RigidShape<G::dim>& shape, const Body<G>& rigid, Body<
     ++moved;
   }
   return moved;
+}
+
+/// Move a rigid shape's anchor with its body over the step, as move_rigid_points moves its points
+/// (`grid`: the global grid).
+template <class G>
+void move_anchor(RigidShape<G::dim>& shape, const RigidMotion<G>& rm, const Grid<G::dim>& grid, double dt_s) {
+  Vec<G::dim> x = shape.anchor_m + dt_s * rm.velocity_m_s.template head<G::dim>();
+  grid.wrap(x);
+  shape.anchor_m = x;
 }
 
 /// Move a rigid body's points rigidly over the step (replaces G2P): x ← x + Δt V, v ← V, C = 0,

@@ -136,6 +136,17 @@ class Decomposition {
     return Grid<D>(origin, global_.h_m, cells, periodic);
   }
 
+  /// Whether this rank owns the local grid's nodes with logical index l along axis a (see the
+  /// header: [0, n) of a split axis, and the ghost layers beyond a non-periodic domain's end; every
+  /// node along an axis that is not split).
+  bool owns(int a, int l) const {
+    if (!split(a)) return true;
+    const bool first = coords_[a] == 0, last = coords_[a] == dims_[a] - 1, periodic = global_.periodic[a];
+    if (l < 0) return first && !periodic;
+    if (l >= block_cells(a)) return last && !periodic;
+    return true;
+  }
+
   /// The neighbour along axis a on side `upper` (wrapping on periodic axes), or −1.
   int neighbour(int a, bool upper) const {
     if (!split(a)) return -1;

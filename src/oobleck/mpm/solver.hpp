@@ -247,17 +247,16 @@ class Solver {
   /// Domain decomposition (decomposition.hpp, docs/mpi.md): from here on this rank solves on its
   /// block's local grid and keeps only the points inside its block; the step exchanges the
   /// nodal sums and values with the neighbours and moves points that cross a block face. Call
-  /// once, after the bodies are filled and the boundaries set, before the first step. Third
-  /// bodies (rigid bodies, contact, motors) are not decomposed yet: InputError.
+  /// once, after the bodies are filled and the boundaries set, before the first step, on every
+  /// rank with the whole scene. Third bodies: every rank holds each rigid body's motion, each
+  /// contact pair's sums and each motor, completed over the ranks (contact.hpp); a free rigid
+  /// body's shape is built here, from all its points.
   void decompose(const Decomposition<D>& dec) {
     if (dec_) throw InputError("mpm: the solver is already decomposed");
-    for (int b = 0; b < body_count(); ++b)
-      if (rigid_[b].rigid() || std::any_of(contacts_.begin(), contacts_.end(), [b](auto& c) { return c.solid == b; }) ||
-          std::any_of(motors_.begin(), motors_.end(), [b](auto& m) { return m.body == b; }))
-        throw InputError(
-            fmt::format("mpm: a decomposed run (mpirun -np {}) does not support third bodies yet (body '{}': "
-                        "rigid bodies, contact and motors run on one rank)",
-                        dec.ranks(), bodies_[b]->name));
+    for (auto& c : contacts_)
+      if (rigid_[c.solid].kind == BodyMotion::FreeRigid && !c.shape.built)
+        build_rigid_shape(c.shape, *bodies_[c.solid], grid_);
+    contact_weight_.clear();  // (recomputed on the local grid, owned nodes only)
     dec_ = std::make_unique<Decomposition<D>>(dec);
     grid_ = dec_->local_grid();
     for (int a = 0; a < D; ++a) {  // faces inside the domain (or across a split periodic axis) are open
@@ -266,11 +265,18 @@ class Solver {
       if (dec_->coords()[a] < dec_->dims()[a] - 1 || dec_->global().periodic[a]) bc_[2 * a + 1] = FaceCondition{};
     }
     for (auto& f : fields_) f.resize(grid_.node_count(), threads_);
+    for (auto& c : contacts_) {
+      c.mass_gradient.assign(static_cast<std::size_t>(grid_.node_count()), Vec<D>::Zero());
+      c.volume_m3.assign(static_cast<std::size_t>(grid_.node_count()), 0.0);
+    }
     for (auto& b : bodies_) keep_owned_points(*b, *dec_);
     halo_ = std::make_unique<Halo<D>>(*dec_, grid_);
   }
   /// The decomposition, or nullptr (one rank).
   const Decomposition<D>* decomposition() const { return dec_.get(); }
+  /// The whole domain's grid: grid() on one rank, the decomposition's global grid otherwise (for
+  /// positions: periodic images, the domain's bounds).
+  const Grid<D>& global_grid() const { return dec_ ? dec_->global() : grid_; }
   /// Bytes this rank sent in the nodal exchanges so far (0 on one rank).
   std::int64_t halo_bytes_sent() const { return halo_ ? halo_->bytes_sent() : 0; }
   /// Points that left this rank for another so far (0 on one rank).
@@ -314,7 +320,7 @@ class Solver {
       particles_to_grid_all<K>();                           // 2. P2G: shape functions, mass, momentum, forces, gravity
       if (halo_) timed_exchange([&] { sum_to_owners(); });  // (decomposed: partial sums to the owners)
       clock.lap(timings_.p2g);
-      prepare_contact_arrays();
+      prepare_rigid_and_contact();
       update_grid_and_couple(                           // 3. grid: walls fold ghosts, rigid predictions; porosity,
           [this] { scatter_contact_gradients<K>(); });  // buoyancy (E28), v = (mv + Δt f)/m,
                                                         //    drag (E29); beside it, contact's mass gradients
@@ -452,7 +458,7 @@ class Solver {
     const int nbodies = body_count();
     auto fold_and_predict = [&](int b) {
       fold_wall_images<G>(grid_, bc_, fields_[b]);
-      if (rigid_[b].rigid()) predict_rigid(rigid_[b], *bodies_[b], fields_[b], opt_.gravity_m_s2, dt);
+      if (rigid_[b].rigid()) predict_rigid(rigid_[b], fields_[b], opt_.gravity_m_s2, dt);
     };
     // Deformable solids (the wheel): their predictions join the mixture's pass over the nodes
     // below when there is a fluid; otherwise they get their own pass.
@@ -552,17 +558,72 @@ class Solver {
     }
   }
 
-  /// Contact (model.md §8), part 1, before the grid pass: the node weights and measures (once)
-  /// and the arrays part 2 fills.
-  void prepare_contact_arrays() {
+  /// Before the grid pass (on the main thread: it may talk to the other ranks): the rigid bodies'
+  /// masses (over every rank); contact (model.md §8), part 1: the node weights and measures (once;
+  /// decomposed: 0 on the nodes another rank owns), the arrays part 2 fills, and the box of the
+  /// mixture's points near the solids (part 2's scatter_mass_gradient_near).
+  void prepare_rigid_and_contact() {
+    for (int b = 0; b < body_count(); ++b) {
+      if (!rigid_[b].rigid()) continue;
+      double M = 0.0;
+      for (double m : bodies_[b]->mass_kg) M += m;
+      if (dec_) comm::sum_ordered({&M, 1});
+      rigid_[b].mass_kg = M;
+    }
     if (contacts_.empty()) return;
     if (contact_weight_.empty()) {  // once: node weights and measures (boundaries are set by now)
       contact_weight_ = detail::contact_node_weights<D>(grid_, bc_);
+      if (dec_)
+        for (int i = 0; i < grid_.node_count(); ++i) {
+          const auto s = grid_.unflatten(i);
+          for (int a = 0; a < D; ++a)
+            if (!dec_->owns(a, grid_.logical_index(a, s[a]))) contact_weight_[i] = 0.0;
+        }
       node_measure_.resize(contact_weight_.size());
       for (int i = 0; i < grid_.node_count(); ++i) node_measure_[i] = node_measure<G>(grid_, i);
     }
     mixture_gradient_.resize(contact_weight_.size());
     mixture_volume_.resize(contact_weight_.size());  // (each pair's arrays are sized with it)
+    // (the box is used where the fluid gives the mixture's volume and a pair has the combined normal)
+    const bool near = fluid_ >= 0 && std::any_of(contacts_.begin(), contacts_.end(),
+                                                 [](const ContactPair<G>& c) { return c.combined_normal; });
+    solids_box_ = near ? box_around_contact_solids() : Box{};
+  }
+
+  /// A box around every contact solid's points (over every rank), grown by two kernel widths:
+  /// the mixture's points that reach the nodes where a solid has mass lie inside.
+  struct Box {
+    bool any = false;
+    Vec<D> centre = Vec<D>::Zero(), half = Vec<D>::Zero();
+  };
+  Box box_around_contact_solids() const {
+    const Grid<D>& grid = global_grid();
+    Vec<D> ref = Vec<D>::Constant(INFINITY);  // the first solid's reference point (every rank's)
+    for (const auto& c : contacts_) {
+      ref = body_reference(*bodies_[c.solid], dec_ != nullptr);
+      if (std::isfinite(ref[0])) break;
+    }
+    Box box;
+    if (!std::isfinite(ref[0])) return box;  // no solid has points
+    double lo_hi[2 * D];                     // lo, −hi (one minimum over the ranks)
+    std::fill(lo_hi, lo_hi + 2 * D, INFINITY);
+    for (const auto& c : contacts_) {
+      const auto& sb = *bodies_[c.solid];
+      for (std::int64_t p = 0; p < sb.size(); ++p) {
+        const Vec<D> d = periodic_difference<D>(grid, sb.x_m[p], ref);
+        for (int a = 0; a < D; ++a) {
+          lo_hi[a] = std::min(lo_hi[a], d[a]);
+          lo_hi[D + a] = std::min(lo_hi[D + a], -d[a]);
+        }
+      }
+    }
+    if (dec_) comm::min(lo_hi);
+    const Vec<D> lo = Eigen::Map<const Vec<D>>(lo_hi), hi = -Eigen::Map<const Vec<D>>(lo_hi + D);
+    const double margin = 2.0 * kernel_support(opt_.shape) * grid_.h_m;
+    box.any = true;
+    box.centre = ref + 0.5 * (lo + hi);
+    box.half = 0.5 * (hi - lo) + Vec<D>::Constant(margin);
+    return box;
   }
 
   /// Contact, part 2: the nodal mass gradients (and volumes) of the mixture near the solids and of
@@ -588,25 +649,10 @@ class Solver {
     mixture_volume_scattered_ = false;
     if (mix >= 0 && fluid && combined) {
       // Mixture mass gradient only (the fluid gives the volume), from the mixture points near
-      // the solids: a box around all contact solids' points, grown by two kernel widths.
-      Vec<D> lo = Vec<D>::Constant(INFINITY), hi = Vec<D>::Constant(-INFINITY), ref = Vec<D>::Zero();
-      bool any = false;
-      for (const auto& c : contacts_) {
-        const auto& sb = *bodies_[c.solid];
-        for (std::int64_t p = 0; p < sb.size(); ++p) {
-          if (!any) ref = sb.x_m[p];
-          any = true;
-          const Vec<D> d = periodic_difference<D>(grid_, sb.x_m[p], ref);
-          lo = lo.cwiseMin(d);
-          hi = hi.cwiseMax(d);
-        }
-      }
-      if (any) {
-        const double margin = 2.0 * kernel_support(opt_.shape) * grid_.h_m;
-        const Vec<D> centre = ref + 0.5 * (lo + hi);
-        const Vec<D> half = 0.5 * (hi - lo) + Vec<D>::Constant(margin);
-        scatter_mass_gradient_near<G, K>(*bodies_[mix], caches_[mix], grid_, centre, half, mixture_gradient_,
-                                         plane_mix);
+      // the solids (solids_box_, part 1).
+      if (solids_box_.any) {
+        scatter_mass_gradient_near<G, K>(*bodies_[mix], caches_[mix], global_grid(), solids_box_.centre,
+                                         solids_box_.half, mixture_gradient_, plane_mix);
       } else {
         for (auto& g : mixture_gradient_) g.setZero();
       }
@@ -634,36 +680,53 @@ class Solver {
     // walls), else the grains' (scattered in part 2; fluid-free beds).
     const double* mixture_volume = mixture_volume_scattered_ ? mixture_volume_.data() : nullptr;
     if (fluid) mixture_volume = fluid->volume_m3.data();
+    if (halo_) timed_exchange([&] { sum_contact_arrays_to_owners(); });
     for (auto& rm : rigid_) rm.velocity_m_s = rm.predicted_m_s;
+    const bool across_ranks = dec_ != nullptr;
     for (auto& c : contacts_) {
       RigidMotion<G>& rm = rigid_[c.solid];
       const Vec<D>* mix_grad = c.combined_normal ? mixture_gradient_.data() : nullptr;
       if (rm.kind == BodyMotion::FreeRigid && rm.mass_kg > 0.0) {  // whole-body solve
         const Vec<NC> J = resolve_rigid_contact(c, rm, fields_[c.solid], grains, fluid, contact_weight_, mixture_volume,
-                                                node_measure_, mix_grad, opt_.dt_s);
+                                                node_measure_, mix_grad, across_ranks, opt_.dt_s);
         rm.velocity_m_s += J.cwiseProduct(rm.free_mask) / rm.mass_kg;
       } else {  // deformable or prescribed: node by node
         resolve_contact(c, rm, fields_[c.solid], grains, fluid, contact_weight_, mixture_volume, node_measure_,
-                        mix_grad, opt_.dt_s);
+                        mix_grad, across_ranks, opt_.dt_s);
       }
     }
   }
 
+  /// Decomposed runs, before the contacts: contact's nodal sums of part 2 (each pair's mass
+  /// gradient and volume, the mixture's gradient and scattered volume) completed on their owners.
+  void sum_contact_arrays_to_owners() {
+    std::vector<NodalArray> arrays;
+    for (auto& c : contacts_) arrays.insert(arrays.end(), {nodal(c.mass_gradient), nodal(c.volume_m3)});
+    arrays.push_back(nodal(mixture_gradient_));
+    if (mixture_volume_scattered_) arrays.push_back(nodal(mixture_volume_));
+    halo_->sum(arrays);
+  }
+
   /// Contact, part 4 (after the points moved): mixture points inside a free rigid body put back
   /// outside it (contact.hpp, keep_points_out; serial, a test per mixture point).
+  /// (The shape's anchor moves with the body, as its points did in update_points; a shape is
+  /// built at its first use, from the moved points.)
   void keep_mixture_out_of_free_rigid_bodies() {
     for (auto& c : contacts_) {
       if (rigid_[c.solid].kind != BodyMotion::FreeRigid) continue;
-      if (!c.shape.built) build_rigid_shape(c.shape, *bodies_[c.solid], grid_);
+      if (c.shape.built)
+        move_anchor(c.shape, rigid_[c.solid], global_grid(), opt_.dt_s);
+      else
+        build_rigid_shape(c.shape, *bodies_[c.solid], grid_);
       c.points_kept_out = 0;
       for (int b : {grains_, fluid_})
-        if (b >= 0) c.points_kept_out += keep_points_out(c.shape, *bodies_[c.solid], *bodies_[b], grid_);
+        if (b >= 0) c.points_kept_out += keep_points_out(c.shape, *bodies_[b], global_grid());
     }
   }
 
   void apply_motors() {
     if constexpr (std::is_same_v<G, PlaneStrain>)
-      for (auto& m : motors_) apply_motor(m, *bodies_[m.body], grid_, opt_.dt_s);
+      for (auto& m : motors_) apply_motor(m, *bodies_[m.body], global_grid(), dec_ != nullptr, opt_.dt_s);
   }
 
   void check_solid(int b, const char* what) const {
@@ -838,6 +901,7 @@ class Solver {
   std::vector<double> mixture_volume_;     ///< nodal grains volume when there is no fluid body
   std::vector<Vec<D>> mixture_gradient_;   ///< nodal mixture mass gradient (combined normals)
   bool mixture_volume_scattered_ = false;  ///< mixture_volume_ holds this step's grains volume
+  Box solids_box_;                         ///< the mixture's points near the contact solids (this step)
   std::vector<ShapeCache<D>> caches_;
   std::vector<std::int64_t> non_finite_kinematics_;  ///< per body, from the last G2P
   std::vector<GridField<G>> fields_;

@@ -7,10 +7,12 @@
 
 #include "oobleck/analysis/fronts.hpp"
 #include "oobleck/analysis/summary_json.hpp"
+#include "oobleck/core/comm.hpp"
 #include "oobleck/core/error.hpp"
 #include "oobleck/run/analysis_kinds.hpp"
 #include "oobleck/run/body_track.hpp"
 #include "oobleck/run/field_frames.hpp"
+#include "oobleck/run/run_output.hpp"
 
 namespace oobleck::run {
 
@@ -38,7 +40,7 @@ class IntrusionAnalysis final : public SceneAnalysis<G> {
   /// "analysis/uz", "analysis/f" (the sampled fields with the tip) and the track.
   void declare_state(mpm::FieldList& list) override {
     if constexpr (D == 2) {
-      const auto shape = node_field_shape(this->solver().grid());
+      const auto shape = node_field_shape(this->solver().global_grid());
       auto field = [](analysis::IntrusionFrame& f) -> analysis::GridField2D& { return f.field; };
       declare_field_frames(list, "uz", uz_frames_, shape, "m/s", field);
       declare_field_frames(list, "f", f_frames_, shape, "1", field);
@@ -47,24 +49,31 @@ class IntrusionAnalysis final : public SceneAnalysis<G> {
   }
 
  private:
-  /// u_z of the mixture (grains and fluid) and f of the grains on the nodes, with the tip.
+  /// u_z of the mixture (grains and fluid) and f of the grains on the nodes, with the tip
+  /// (decomposed runs: on rank 0, from every rank's points).
   void sample_fields() {
+    const double tip = body_tip(cfg_, scene_);
+    with_every_point_on_root(this->solver(), [&] {
+      if (comm::is_root()) sample_fields(tip);
+    });
+  }
+  void sample_fields(double tip) {
     auto& solver = this->solver();
     std::vector<const mpm::Body<G>*> mix;
     for (int b : {scene_.grains, scene_.fluid})
       if (b >= 0) mix.push_back(&solver.body(b));
-    const double tip = body_tip(cfg_, scene_);
     analysis::IntrusionFrame uz;
     uz.time_s = solver.time_s();
     uz.tip_z_m = tip;
-    uz.field = nodal_average<G>(solver.grid(), mix, [&](std::size_t b, std::int64_t p) { return mix[b]->v_m_s[p][1]; });
+    uz.field =
+        nodal_average<G>(solver.global_grid(), mix, [&](std::size_t b, std::int64_t p) { return mix[b]->v_m_s[p][1]; });
     uz_frames_.push_back(std::move(uz));
     if (scene_.grains >= 0 && scene_.granular_law) {
       const auto* law = scene_.granular_law;
       analysis::IntrusionFrame ff;
       ff.time_s = solver.time_s();
       ff.tip_z_m = tip;
-      ff.field = nodal_average<G>(solver.grid(), {&solver.body(scene_.grains)},
+      ff.field = nodal_average<G>(solver.global_grid(), {&solver.body(scene_.grains)},
                                   [&](std::size_t, std::int64_t p) { return law->f[static_cast<std::size_t>(p)]; });
       f_frames_.push_back(std::move(ff));
     }

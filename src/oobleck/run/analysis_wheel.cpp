@@ -6,7 +6,9 @@
 #include "oobleck/analysis/summary_json.hpp"
 #include "oobleck/analysis/wheel.hpp"
 #include "oobleck/run/analysis_kinds.hpp"
+#include "oobleck/core/comm.hpp"
 #include "oobleck/run/body_track.hpp"
+#include "oobleck/run/run_output.hpp"
 
 namespace oobleck::run {
 
@@ -27,17 +29,22 @@ class WheelAnalysis final : public SceneAnalysis<G> {
   void sample() override { track_.sample(); }
 
   /// SI figure: how smooth the point pressure p~ = -tr(sigma)/3 of the grains is under the wheel.
+  /// (Decomposed runs: measured on rank 0, from every rank's points.)
   void at_frame() override {
     if (scene_.grains < 0) return;
-    const auto& gb = this->solver().body(scene_.grains);
-    std::vector<double> px, py, pp;
-    for (std::int64_t p = 0; p < gb.size(); ++p) {
-      px.push_back(gb.x_m[p][0]);
-      py.push_back(gb.x_m[p][1]);
-      pp.push_back(-gb.stress_Pa[p].trace() / 3.0);
-    }
-    const auto r = analysis::pressure_scatter(px, py, pp, scatter_window());
-    if (r.points > 0) scatter_.push_back({this->solver().time_s(), r});  // else no grains under the wheel
+    const analysis::ScatterWindow window = scatter_window();
+    with_every_point_on_root(this->solver(), [&] {
+      if (!comm::is_root()) return;
+      const auto& gb = this->solver().body(scene_.grains);
+      std::vector<double> px, py, pp;
+      for (std::int64_t p = 0; p < gb.size(); ++p) {
+        px.push_back(gb.x_m[p][0]);
+        py.push_back(gb.x_m[p][1]);
+        pp.push_back(-gb.stress_Pa[p].trace() / 3.0);
+      }
+      const auto r = analysis::pressure_scatter(px, py, pp, window);
+      if (r.points > 0) scatter_.push_back({this->solver().time_s(), r});  // else no grains under the wheel
+    });
   }
 
   nlohmann::json result() const override;
@@ -85,8 +92,8 @@ class WheelAnalysis final : public SceneAnalysis<G> {
   /// Under the wheel: two radii either side of its centre of mass, from three radii below it to
   /// one above, on the grid's cells.
   analysis::ScatterWindow scatter_window() const {
-    const auto& grid = this->solver().grid();
-    const Vd c = centre_of_mass(this->solver().body(scene_.analysed_body().body), grid);
+    const auto& grid = this->solver().global_grid();
+    const Vd c = centre_of_mass(this->solver(), scene_.analysed_body().body);
     const double R = wheel_radius();
     analysis::ScatterWindow w;
     w.x_centre_m = c[0];

@@ -38,13 +38,12 @@ class BodyTrack {
   void sample() {
     auto& solver = *scene_.solver;
     const scene::ThirdBody& tb = scene_.analysed_body();
-    const auto& body = solver.body(tb.body);
+    const BodyTotals<G> totals = body_totals(solver, tb.body);  // (decomposed: every rank's points)
     Sample s;
     s.t = solver.time_s();
-    s.centre = centre_of_mass(body, solver.grid());
-    s.velocity = body.total_momentum() / body.total_mass();
-    s.bottom = INFINITY;
-    for (const auto& x : body.x_m) s.bottom = std::min(s.bottom, x[D - 1]);
+    s.centre = centre_of_mass(solver, tb.body);
+    s.velocity = totals.mean_velocity();
+    s.bottom = totals.lowest_m;
     const Vn J = solver.contact(tb.pair).impulse_sum_N_s;
     s.force = s.t > time_ ? Vn((J - impulse_) / (s.t - time_)) : Vn(solver.contact(tb.pair).force_N);
     impulse_ = J;
@@ -106,8 +105,7 @@ class BodyTrack {
 template <class G>
 double body_tip(const scene::SceneConfig& cfg, const scene::BuiltScene<G>& scene) {
   const scene::ThirdBody& tb = scene.analysed_body();
-  double tip = INFINITY;
-  for (const auto& x : scene.solver->body(tb.body).x_m) tip = std::min(tip, x[G::dim - 1]);
+  const double tip = body_totals(*scene.solver, tb.body).lowest_m;  // (decomposed: every rank's points)
   return tip - 0.5 * cfg.grid.cell_size_m / tb.cfg->points_per_cell;
 }
 

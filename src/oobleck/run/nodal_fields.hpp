@@ -1,34 +1,81 @@
 #pragma once
 // Point-field measures that the scene analyses and snapshots read (run/analysis_*.cpp,
-// run/snapshots.cpp): a body's centre of mass on a periodic grid, and the mass-weighted nodal
-// average of a point quantity (a post-processing interpolation, independent of the solver's
-// kernel).
+// run/snapshots.cpp): a body's centre of mass on a periodic grid and its totals (over every rank
+// in decomposed runs), and the mass-weighted nodal average of a point quantity (a post-processing
+// interpolation, independent of the solver's kernel).
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
 
 #include "oobleck/analysis/data.hpp"
+#include "oobleck/core/comm.hpp"
 #include "oobleck/mpm/body.hpp"
 #include "oobleck/mpm/contact.hpp"
 #include "oobleck/mpm/grid.hpp"
+#include "oobleck/mpm/solver.hpp"
 
 namespace oobleck::run {
 
-/// Centre of mass of a body, periodic axes unwrapped about its first point (then wrapped).
+/// Centre of mass of body b, periodic axes unwrapped about its first point (then wrapped);
+/// decomposed runs: over every rank's points, about a reference every rank shares
+/// (mpm::body_reference). Zero for a body without points.
 template <class G>
-mpm::Vec<G::dim> centre_of_mass(const mpm::Body<G>& body, const mpm::Grid<G::dim>& grid) {
+mpm::Vec<G::dim> centre_of_mass(mpm::Solver<G>& solver, int b) {
   constexpr int D = G::dim;
-  if (body.size() == 0) return mpm::Vec<D>::Zero();
-  const mpm::Vec<D> x0 = body.x_m[0];
+  const mpm::Body<G>& body = solver.body(b);
+  const bool across = solver.decomposition() != nullptr;
+  const mpm::Grid<D>& grid = solver.global_grid();
+  const mpm::Vec<D> x0 = mpm::body_reference(body, across);
+  if (!std::isfinite(x0[0])) return mpm::Vec<D>::Zero();
   mpm::Vec<D> s = mpm::Vec<D>::Zero();
   double M = 0.0;
   for (std::int64_t p = 0; p < body.size(); ++p) {
     s += body.mass_kg[p] * mpm::periodic_difference<D>(grid, body.x_m[p], x0);
     M += body.mass_kg[p];
   }
+  if (across) {
+    double sums[D + 1];
+    std::copy_n(s.data(), D, sums);
+    sums[D] = M;
+    comm::sum(sums);
+    s = Eigen::Map<const mpm::Vec<D>>(sums);
+    M = sums[D];
+  }
   mpm::Vec<D> c = x0 + s / M;
   grid.wrap(c);
   return c;
+}
+
+/// Whole-body totals of body b (decomposed runs: over every rank's points): points, mass,
+/// momentum, and the lowest coordinate along the last axis (+inf without points).
+template <class G>
+struct BodyTotals {
+  std::int64_t points = 0;
+  double mass_kg = 0.0, lowest_m = INFINITY;
+  mpm::Vec<G::ncomp> momentum = mpm::Vec<G::ncomp>::Zero();
+  mpm::Vec<G::ncomp> mean_velocity() const { return momentum / mass_kg; }
+};
+template <class G>
+BodyTotals<G> body_totals(mpm::Solver<G>& solver, int b) {
+  constexpr int NC = G::ncomp;
+  const mpm::Body<G>& body = solver.body(b);
+  BodyTotals<G> t;
+  t.points = body.size();
+  t.mass_kg = body.total_mass();
+  t.momentum = body.total_momentum();
+  for (const auto& x : body.x_m) t.lowest_m = std::min(t.lowest_m, x[G::dim - 1]);
+  if (solver.decomposition()) {
+    double sums[NC + 1];
+    std::copy_n(t.momentum.data(), NC, sums);
+    sums[NC] = t.mass_kg;
+    comm::sum(sums);
+    t.momentum = Eigen::Map<const mpm::Vec<NC>>(sums);
+    t.mass_kg = sums[NC];
+    t.points = comm::sum(t.points);
+    t.lowest_m = comm::min(t.lowest_m);
+  }
+  return t;
 }
 
 /// Mass-weighted nodal average of a point quantity over one or more bodies on the physical

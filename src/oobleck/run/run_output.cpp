@@ -188,7 +188,7 @@ std::vector<double> series_row(const scene::BuiltScene<G>& scene) {
                   r.begin() + static_cast<long>(2 + static_cast<std::size_t>(b) * (NC + 3)));
   }
   for (const auto& tb : scene.third) {
-    const mpm::Vec<D> c = centre_of_mass(solver.body(tb.body), solver.grid());
+    const mpm::Vec<D> c = centre_of_mass(solver, tb.body);  // (decomposed: every rank's points)
     for (int k = 0; k < D; ++k) r.push_back(c[k]);
     const mpm::Vec<NC> F = solver.contact(tb.pair).force_N;
     for (int k = 0; k < NC; ++k) r.push_back(F[k]);

@@ -62,13 +62,13 @@ nlohmann::json bodies_summary(const scene::BuiltScene<G>& scene) {
   nlohmann::json bodies = nlohmann::json::object();
   const double whole = std::is_same_v<G, mpm::Axisymmetric> ? 2.0 * M_PI : 1.0;
   for (const auto& tb : scene.third) {
-    const auto& body = solver.body(tb.body);
-    const mpm::Vec<D> c = centre_of_mass(body, solver.grid());
-    const mpm::Vec<NC> v = body.total_momentum() / body.total_mass();
+    const BodyTotals<G> totals = body_totals(solver, tb.body);  // (decomposed: every rank's points)
+    const mpm::Vec<D> c = centre_of_mass(solver, tb.body);
+    const mpm::Vec<NC> v = totals.mean_velocity();
     const mpm::Vec<NC> F = solver.contact(tb.pair).force_N;
     bodies[tb.cfg->name] = {{"motion", scene::to_string(tb.cfg->motion)},
-                            {"points", body.size()},
-                            {"mass", whole * body.total_mass()},
+                            {"points", totals.points},
+                            {"mass", whole * totals.mass_kg},
                             {"centre", std::vector<double>(c.data(), c.data() + D)},
                             {"velocity", std::vector<double>(v.data(), v.data() + NC)},
                             {"contact_force_last_step", std::vector<double>(F.data(), F.data() + NC)}};

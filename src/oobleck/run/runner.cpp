@@ -123,17 +123,11 @@ void SceneRun<G>::check_decomposable() const {
     return;
   }
   const auto kind = cfg_.analysis.kind;
-  if (kind != scene::AnalysisKind::None && kind != scene::AnalysisKind::Settling &&
-      kind != scene::AnalysisKind::Couette)
+  if (kind == scene::AnalysisKind::Annular)
     throw InputError(
         fmt::format("{}: [analysis] kind = \"{}\" does not run decomposed yet (mpirun -np {}); run it on "
                     "one rank (threads: --threads)",
                     cfg_.file, scene::to_string(kind), ranks));
-  if (!scene_.third.empty())
-    throw InputError(
-        fmt::format("{}: [[body]] '{}': third bodies (rigid, driven, elastic with contact) do not run "
-                    "decomposed yet (mpirun -np {}); run the scene on one rank",
-                    cfg_.file, scene_.third.front().cfg->name, ranks));
   if (!cfg_.analysis.snapshot_times_s.empty())
     throw InputError(
         fmt::format("{}: analysis.snapshot_times: snapshots are not written by decomposed runs yet", cfg_.file));
