@@ -425,7 +425,8 @@ Vec<G::ncomp> finish_pair_sums(ContactPair<G>& pair, const Vec<G::ncomp>& J_body
   }
   sums[2 * NC] = active;
   if (across_ranks) comm::sum_ordered(sums);
-  const Vec<NC> J = Eigen::Map<const Vec<NC>>(sums), Jg = Eigen::Map<const Vec<NC>>(sums + NC);
+  Vec<NC> J = Eigen::Map<const Vec<NC>>(sums);
+  const Vec<NC> Jg = Eigen::Map<const Vec<NC>>(sums + NC);
   pair.active_nodes = static_cast<int>(sums[2 * NC]);
   pair.force_N = J / dt_s;
   pair.force_on_grains_N = Jg / dt_s;
