@@ -110,7 +110,7 @@ void sum([[maybe_unused]] std::span<std::int64_t> values) {
 #endif
 }
 
-void sum_ordered(std::span<double> values) {
+void sum_ordered([[maybe_unused]] std::span<double> values) {
 #ifdef OOBLECK_HAVE_MPI
   if (!active() || values.empty()) return;
   Timed t;
