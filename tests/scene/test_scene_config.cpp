@@ -1,5 +1,6 @@
 // Scene files: typed, validated configuration; --set overrides with short aliases; errors name
 // the file, the key and the rule.
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -187,6 +188,25 @@ TEST(SceneConfig, EveryCommittedSceneFileLoads) {
   EXPECT_GE(others, 5);  // three verification scenes, two benchmark set-ups
 }
 
+TEST(SceneConfig, TiltedCylinderTurnsItsAxisAndLaunchVelocity) {
+  const std::string f = std::string(OOBLECK_SOURCE_DIR) + "/scenes/paper/rod_impact_3d.toml";
+  const auto c = scene::load_scene(f, {"tilt_deg=30", "v0=2"});
+  const auto& b = c.bodies[0];
+  EXPECT_EQ(b.shape, scene::BodyShape::Cylinder);
+  // (0, 0, -2) turned by 30 deg about y towards +x on top: down and towards -x, |v| = 2.
+  EXPECT_NEAR(b.velocity_m_s[0], -1.0, 1e-12);
+  EXPECT_NEAR(b.velocity_m_s[1], 0.0, 1e-12);
+  EXPECT_NEAR(b.velocity_m_s[2], -std::sqrt(3.0), 1e-12);
+  const auto fr = scene::cylinder_frame(b);
+  EXPECT_NEAR(fr.axis[0], 0.5, 1e-12);
+  EXPECT_NEAR(fr.axis[2], std::sqrt(3.0) / 2, 1e-12);
+  // The bottom rim's lowest point stays on the surface: base raised by r sin 30 = r/2.
+  EXPECT_NEAR(fr.base_m[2], 0.1 + 0.5 * b.radius_m, 1e-15);
+  EXPECT_NEAR(fr.lo_m[2], 0.1, 1e-15);  // lowest point of the bottom rim: base_z - r sin 30
+  // Top face centre at base + L axis; its rim reaches r cos 30 further along x.
+  EXPECT_NEAR(fr.hi_m[0], b.length_m * 0.5 + b.radius_m * std::sqrt(3.0) / 2, 1e-15);
+}
+
 TEST(SceneConfig, BodyErrorsNameTheKeyAndRule) {
   EXPECT_NE(intrusion_error("density = 2700.0", "density = -1.0").find("body[0].density"), std::string::npos);
   // Names become folders and HDF5 groups: refused at load time, before any output.
@@ -211,4 +231,18 @@ TEST(SceneConfig, BodyErrorsNameTheKeyAndRule) {
   EXPECT_NE(intrusion_error("kind = \"intrusion\"", "kind = \"wheel\"").find("plane-strain grid"), std::string::npos);
   EXPECT_NE(intrusion_error("name = \"intruder\"", "name = \"grains\"").find("differ from the phases"),
             std::string::npos);
+  EXPECT_NE(intrusion_error("shape = \"box\"", "shape = \"cylinder\"").find("cylinders are 3D bodies"),
+            std::string::npos);
+  const std::string rod3d = std::string(OOBLECK_SOURCE_DIR) + "/scenes/paper/rod_impact_3d.toml";
+  auto rod3d_error = [&](const std::string& set) {
+    try {
+      scene::load_scene(rod3d, {set});
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(rod3d_error("tilt_deg=90").find("body[0].tilt"), std::string::npos);
+  EXPECT_NE(rod3d_error("body.0.radius=0").find("body[0].radius"), std::string::npos);
+  EXPECT_NE(rod3d_error("body.0.length=0.05").find("inside the grid"), std::string::npos);  // top above z = 0.14
 }

@@ -15,6 +15,7 @@
 #include "oobleck/analysis/annular.hpp"
 #include "oobleck/io/checkpoint.hpp"
 #include "oobleck/run/runner.hpp"
+#include "oobleck/scene/build.hpp"
 #include "oobleck/scene/config.hpp"
 
 using namespace oobleck;
@@ -310,6 +311,33 @@ TEST(PaperScenes, RodDeceleratesSharplyAtImpactThenSinksSlowly) {
   double impulse = 0.0;
   for (std::size_t k = 0; k < F.size(); ++k) impulse += F[k] * (tf[k] - (k ? tf[k - 1] : 0.0));
   EXPECT_NEAR(M * (v.back() - v.front()), impulse - M * g * tf.back(), 1e-9 * M);
+}
+
+TEST(PaperScenes, Rod3dCylinderHasTheVolumeCentroidAndLowestPointOfItsShape) {
+  // The 3D rod (rod_impact_3d.toml) tilted by 30 deg, on a fine point lattice (0.625 mm spacing
+  // for a 9.5 mm radius): its points' volume approaches pi r^2 L, their centroid lies on the
+  // axis half a length above the bottom face's centre, their lowest point on the free surface.
+  const auto c = scene::load_scene(std::string(OOBLECK_SOURCE_DIR) + "/scenes/paper/rod_impact_3d.toml",
+                                   {"cell_size=0.005", "tilt_deg=30", "body.0.points_per_cell=8"});
+  const auto s = scene::build_scene<mpm::ThreeD>(c, 1);
+  const auto& rod = s.solver->body(s.third[0].body);
+  const auto& b = c.bodies[0];
+  const auto f = scene::cylinder_frame(b);
+  double V = 0.0, M = 0.0, zmin = INFINITY;
+  mpm::Vec<3> xc = mpm::Vec<3>::Zero();
+  for (std::size_t p = 0; p < rod.x_m.size(); ++p) {
+    V += rod.volume_m3[p];
+    M += rod.mass_kg[p];
+    xc += rod.volume_m3[p] * rod.x_m[p];
+    zmin = std::min(zmin, rod.x_m[p][2]);
+  }
+  xc /= V;
+  const double spacing = 0.005 / 8;
+  EXPECT_NEAR(V / (M_PI * b.radius_m * b.radius_m * b.length_m), 1.0, 0.02);
+  EXPECT_NEAR(M, 0.3, 1e-12);  // `mass` is the whole rod's
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(xc[a], f.base_m[a] + 0.5 * b.length_m * f.axis[a], 0.5 * spacing) << a;
+  EXPECT_NEAR(zmin, 0.1, spacing);  // the lowest rim point on the surface (z = 0.1), within a spacing
+  EXPECT_GE(zmin, 0.1 - 1e-12);
 }
 
 TEST(PaperScenes, RodRunRestartsBitForBit) {

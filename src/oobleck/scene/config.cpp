@@ -172,8 +172,10 @@ constexpr std::array<std::pair<const char*, BoundaryType>, 7> kBoundaries{{{"no_
 constexpr std::array<std::pair<const char*, Phase>, 4> kPhases{
     {{"mixture", Phase::Mixture}, {"fluid", Phase::Fluid}, {"grains", Phase::Grains}, {"elastic", Phase::Elastic}}};
 
-constexpr std::array<std::pair<const char*, BodyShape>, 3> kBodyShapes{
-    {{"box", BodyShape::Box}, {"disc", BodyShape::Disc}, {"wheel", BodyShape::Wheel}}};
+constexpr std::array<std::pair<const char*, BodyShape>, 4> kBodyShapes{{{"box", BodyShape::Box},
+                                                                        {"disc", BodyShape::Disc},
+                                                                        {"wheel", BodyShape::Wheel},
+                                                                        {"cylinder", BodyShape::Cylinder}}};
 constexpr std::array<std::pair<const char*, BodyMotionKind>, 3> kMotions{
     {{"prescribed", BodyMotionKind::Prescribed}, {"free", BodyMotionKind::Free}, {"elastic", BodyMotionKind::Elastic}}};
 constexpr std::array<std::pair<const char*, AnalysisKind>, 7> kAnalyses{{{"none", AnalysisKind::None},
@@ -396,14 +398,31 @@ std::array<BoundaryConfig, 6> read_boundary(io::TomlReader& top, const std::stri
   return boundary;
 }
 
-/// A [[body]]'s shape: a box, or (plane strain) a disc or a paddle wheel, inside the grid along
-/// every axis that is not periodic.
+/// A [[body]]'s shape: a box, (plane strain) a disc or a paddle wheel, or (3D) a cylinder, inside
+/// the grid along every axis that is not periodic.
 void read_body_shape(io::TomlReader& r, const SceneConfig& c, BodyConfig& b) {
   const int dim = c.grid.dim;
   auto inside_grid = [&](std::string_view key, double lo, double hi, int a) {
     r.require(lo >= c.grid.origin_m[a] - 1e-12 && hi <= c.grid.origin_m[a] + c.grid.size_m[a] + 1e-12, key, hi,
               fmt::format("the body must lie inside the grid along axis {}", a));
   };
+  if (b.shape == BodyShape::Cylinder) {
+    if (c.grid.geometry != Geometry::ThreeD) {
+      r.fail("shape", "cylinders are 3D bodies (axisymmetric: a box from r = 0 is a cylinder on the axis)");
+    }
+    b.centre_m = read_vec(r, "centre", dim, {0, 0, 0}, true);
+    b.radius_m = r.number("radius");
+    b.length_m = r.number("length");
+    b.tilt_deg = r.number_or("tilt", 0.0);
+    r.require(b.radius_m > 0, "radius", b.radius_m, "must be positive [m]");
+    r.require(b.length_m > 0, "length", b.length_m, "must be positive [m]");
+    r.require(std::fabs(b.tilt_deg) < 90.0, "tilt", b.tilt_deg, "must lie in (-90, 90) [deg] from the vertical");
+    const CylinderFrame f = cylinder_frame(b);
+    for (int a = 0; a < dim; ++a) {
+      if (!(c.boundary[2 * a].type == BoundaryType::Periodic)) inside_grid("centre", f.lo_m[a], f.hi_m[a], a);
+    }
+    return;
+  }
   if (b.shape == BodyShape::Box) {
     b.min_m = read_vec(r, "min", dim, {0, 0, 0}, true);
     b.max_m = read_vec(r, "max", dim, {0, 0, 0}, true);
@@ -495,6 +514,11 @@ BodyConfig read_body(io::TomlReader& r, std::size_t index, const SceneConfig& c)
     for (double v : b.velocity_m_s) n2 += v * v;
     if (!(n2 > 0)) r.fail("speed", "needs a non-zero `velocity` giving the direction of motion");
     for (double& v : b.velocity_m_s) v *= *speed / std::sqrt(n2);
+  }
+  if (b.shape == BodyShape::Cylinder && b.tilt_deg != 0.0) {  // an oblique launch along the tilted axis
+    const double t = b.tilt_deg * M_PI / 180.0, vx = b.velocity_m_s[0], vz = b.velocity_m_s[2];
+    b.velocity_m_s[0] = std::cos(t) * vx + std::sin(t) * vz;
+    b.velocity_m_s[2] = -std::sin(t) * vx + std::cos(t) * vz;
   }
   if (r.has("ramp_time") && b.motion != BodyMotionKind::Prescribed)
     r.fail("ramp_time", "only a prescribed body (motion = \"prescribed\") takes a ramp_time");
@@ -662,6 +686,20 @@ const char* name_of(E e, const std::array<std::pair<const char*, E>, N>& names) 
 }
 
 }  // namespace
+
+CylinderFrame cylinder_frame(const BodyConfig& b) {
+  CylinderFrame f;
+  const double t = b.tilt_deg * M_PI / 180.0;
+  f.axis = {std::sin(t), 0.0, std::cos(t)};
+  f.base_m = {b.centre_m[0], b.centre_m[1], b.centre_m[2] + b.radius_m * std::fabs(std::sin(t))};
+  for (int a = 0; a < 3; ++a) {
+    const double top = f.base_m[a] + b.length_m * f.axis[a];
+    const double rim = b.radius_m * std::sqrt(std::max(0.0, 1.0 - f.axis[a] * f.axis[a]));
+    f.lo_m[a] = std::min(f.base_m[a], top) - rim;
+    f.hi_m[a] = std::max(f.base_m[a], top) + rim;
+  }
+  return f;
+}
 
 const char* to_string(Geometry g) { return name_of(g, kGeometries); }
 const char* to_string(ShapeKind s) { return name_of(s, kShapes); }

@@ -72,7 +72,7 @@ struct RegionConfig {
 };
 
 /// Shape of a third body (model.md §8). Axisymmetric: a box touching r = 0 is a cylinder.
-enum class BodyShape { Box, Disc, Wheel };
+enum class BodyShape { Box, Disc, Wheel, Cylinder };
 /// How a third body moves: rigid at a fixed velocity (intruder), free rigid translation under
 /// gravity and contact (rod), or elastic (wheel; optionally with a motor on its mean ω).
 enum class BodyMotionKind { Prescribed, Free, Elastic };
@@ -82,9 +82,11 @@ struct BodyConfig {
   std::string name;
   BodyShape shape = BodyShape::Box;
   std::array<double, 3> min_m{0, 0, 0}, max_m{0, 0, 0};  ///< [m] box corners (shape = "box")
-  std::array<double, 3> centre_m{0, 0, 0};               ///< [m] centre (disc, wheel)
-  double radius_m = 0.0;                                 ///< [m] disc radius
-  double hub_radius_m = 0.0;                             ///< [m] wheel hub radius
+  std::array<double, 3> centre_m{0, 0, 0};  ///< [m] centre (disc, wheel); cylinder: its bottom face's centre
+  double radius_m = 0.0;                    ///< [m] disc or cylinder radius
+  double length_m = 0.0;                    ///< [m] cylinder length along its axis
+  double tilt_deg = 0.0;         ///< [deg] cylinder: its axis and velocity turned from the vertical towards +x
+  double hub_radius_m = 0.0;     ///< [m] wheel hub radius
   double paddle_length_m = 0.0;  ///< [m] paddle length beyond the hub (tip radius = hub + paddle)
   double paddle_width_m = 0.0;   ///< [m] paddle width
   int paddles = 4;               ///< number of paddles (spokes)
@@ -103,6 +105,19 @@ struct BodyConfig {
   std::optional<double> motor_omega_rad_s;  ///< [rad/s] motor target ω (elastic, plane strain)
   double motor_gain = 1.0;                  ///< [-] fraction of the ω error removed per step
 };
+
+/// A cylinder's frame ([[body]] shape = "cylinder", 3D grids; z is vertical): its unit axis,
+/// turned by `tilt` from +z towards +x about the y axis, and the centre of its bottom face, raised
+/// by radius |sin(tilt)| above `centre` so that the lowest point of the bottom rim stays at
+/// `centre`'s height. The body is the set of x with 0 <= (x - base).axis <= length and distance
+/// from the axis <= radius.
+struct CylinderFrame {
+  std::array<double, 3> axis{0, 0, 1};    ///< unit vector from the bottom face to the top face
+  std::array<double, 3> base_m{0, 0, 0};  ///< [m] centre of the bottom face
+  /// [m] the bounding box of the two end discs
+  std::array<double, 3> lo_m{0, 0, 0}, hi_m{0, 0, 0};
+};
+CylinderFrame cylinder_frame(const BodyConfig& b);
 
 struct BoundaryConfig {
   BoundaryType type = BoundaryType::NoSlip;

@@ -1,6 +1,6 @@
 #pragma once
 // Scene [[body]] entries (scene/config.hpp BodyConfig) turned into solver bodies (model.md §8):
-// point lattices for boxes, discs and spoked wheels, the rigid/elastic motion, the contact pair
+// point lattices for boxes, discs, spoked wheels and cylinders, the rigid/elastic motion, the contact pair
 // and the motor (used by scene/build.cpp; prescribed_velocity also by the run loop's ramp).
 #include <algorithm>
 #include <cmath>
@@ -18,7 +18,7 @@
 
 namespace oobleck::scene {
 
-/// Whether x lies inside the body's shape (box, disc, or hub + paddles of a spoked wheel).
+/// Whether x lies inside the body's shape (box, disc, hub + paddles of a spoked wheel, cylinder).
 /// For periodic axes the caller passes x relative to the centre's image (minimum image).
 template <int D>
 bool inside_body(const scene::BodyConfig& b, const mpm::Vec<D>& x) {
@@ -42,6 +42,21 @@ bool inside_body(const scene::BodyConfig& b, const mpm::Vec<D>& x) {
       }
       return false;
     }
+    case scene::BodyShape::Cylinder: {
+      if constexpr (D == 3) {
+        const scene::CylinderFrame f = scene::cylinder_frame(b);
+        double along = 0.0;
+        for (int a = 0; a < 3; ++a) along += (x[a] - f.base_m[a]) * f.axis[a];
+        if (along < 0.0 || along > b.length_m) return false;
+        double off2 = 0.0;
+        for (int a = 0; a < 3; ++a) {
+          const double d = x[a] - f.base_m[a] - along * f.axis[a];
+          off2 += d * d;
+        }
+        return off2 <= b.radius_m * b.radius_m;
+      }
+      return false;  // the configuration allows cylinders on 3D grids only
+    }
   }
   return false;
 }
@@ -53,6 +68,14 @@ void body_bounds(const scene::BodyConfig& b, mpm::Vec<D>& lo, mpm::Vec<D>& hi) {
     for (int a = 0; a < D; ++a) {
       lo[a] = b.min_m[a];
       hi[a] = b.max_m[a];
+    }
+    return;
+  }
+  if (b.shape == scene::BodyShape::Cylinder) {
+    const scene::CylinderFrame f = scene::cylinder_frame(b);
+    for (int a = 0; a < D; ++a) {
+      lo[a] = f.lo_m[a];
+      hi[a] = f.hi_m[a];
     }
     return;
   }
