@@ -369,6 +369,51 @@ TEST(Contact, MotorHoldsMeanAngularVelocityOfFreeElasticWheel) {
   (void)M;
 }
 
+TEST(Contact, MotorTurnsA3dWheelAboutItsAxleInTheXzPlane) {
+  // The wheel of the plane-strain test extruded 4 cm along y (the axle) on a 3D grid, gravity
+  // along -z, motor at omega = 10 rad/s from rest: the mean angular velocity in the (x, z) plane
+  // stays within 1% of omega, the rotation is counter-clockwise from +x towards +z (a point on
+  // the +x paddle moves up), the mean velocity along y stays zero and the centre of mass falls
+  // at exactly g.
+  const double h = 0.02, g = 9.81, omega = 10.0;
+  Grid<3> grid(Vec<3>(-0.5, -0.04, -1.0), h, {50, 4, 75});
+  SolverOptions<ThreeD> opt;
+  opt.threads = 1;
+  opt.gravity_m_s2 = Vec<3>(0.0, 0.0, -g);
+  Solver<ThreeD> s(grid, opt);
+  auto& wheel = s.add_body("wheel");
+  wheel.set_law(std::make_unique<LinearElasticLaw<ThreeD>>(elastic(1e7)));
+  const double dx = h / 2, hub = 0.05, arm = 0.15, half = 0.02;
+  for (double x = -arm + dx / 2; x < arm; x += dx)
+    for (double y = -0.02 + dx / 2; y < 0.02; y += dx)
+      for (double z = -arm + dx / 2; z < arm; z += dx) {
+        const bool in_hub = x * x + z * z < hub * hub;
+        const bool in_spoke = (std::fabs(x) < half || std::fabs(z) < half);
+        if (in_hub || in_spoke) wheel.add_point(Vec<3>(x, y, z), dx * dx * dx, 3000.0);
+      }
+  const int m = s.add_motor(0, omega);
+  s.options().dt_s = s.stable_dt(0.3);
+  s.step();
+  std::int64_t tip = 0;  // the point farthest along +x
+  for (std::int64_t p = 1; p < wheel.size(); ++p)
+    if (wheel.x_m[p][0] > wheel.x_m[tip][0]) tip = p;
+  EXPECT_GT(wheel.v_m_s[tip][2], 0.5 * omega * 0.1);  // moving up at about omega r (r ~ 0.15 m)
+  double worst = 0.0;
+  while (s.time_s() < 0.2) {
+    s.step();
+    double w = 0, I = 0;
+    Vec<3> c, V;
+    angular_state(wheel, s.grid(), false, w, I, c, V);
+    worst = std::max(worst, std::fabs(w - omega));
+    EXPECT_NEAR(V[2], -g * s.time_s(), 1e-9);
+    EXPECT_NEAR(V[0], 0.0, 1e-12);
+    EXPECT_NEAR(V[1], 0.0, 1e-12);
+  }
+  std::printf("[ measured ] 3D motor: max |omega - omega*|/omega* = %.2e\n", worst / omega);
+  EXPECT_LT(worst, 0.01 * omega);
+  EXPECT_GT(s.motor(m).inertia_kg_m2, 0.0);
+}
+
 // ---- free rod dropped onto a fluid: Archimedes ---------------------------------------------------
 
 namespace {

@@ -207,6 +207,34 @@ TEST(SceneConfig, TiltedCylinderTurnsItsAxisAndLaunchVelocity) {
   EXPECT_NEAR(fr.hi_m[0], b.length_m * 0.5 + b.radius_m * std::sqrt(3.0) / 2, 1e-15);
 }
 
+TEST(SceneConfig, VariantsApplyTheirOverridesWhenSetTrue) {
+  const std::string f = std::string(OOBLECK_SOURCE_DIR) + "/scenes/paper/wheel_3d.toml";
+  const auto walled = scene::load_scene(f, {"width_periodic=false"});
+  EXPECT_EQ(walled.boundary[2].type, scene::BoundaryType::NoSlip);
+  EXPECT_DOUBLE_EQ(walled.bodies[0].width_m, 0.3);
+  EXPECT_EQ(walled.grid.cells[1], 45);
+  // The variant, then a later --set (cells keep cubic cells of 33.3 mm: 60 x 4 x 30).
+  const auto c = scene::load_scene(f, {"width_periodic=true", "cells=[60, 4, 30]", "omega=1"});
+  EXPECT_EQ(c.boundary[2].type, scene::BoundaryType::Periodic);
+  EXPECT_EQ(c.boundary[3].type, scene::BoundaryType::Periodic);
+  EXPECT_DOUBLE_EQ(c.bodies[0].width_m, c.grid.size_m[1]);  // the wheel spans the period
+  EXPECT_DOUBLE_EQ(c.regions[0].max_m[1], c.grid.size_m[1]);
+  EXPECT_EQ(c.grid.cells[1], 4);
+  EXPECT_DOUBLE_EQ(*c.bodies[0].motor_omega_rad_s, 1.0);
+  try {
+    scene::load_scene(f, {"width_periodic=yes"});
+    ADD_FAILURE() << "a variant takes true or false";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("takes true or false"), std::string::npos) << e.what();
+  }
+  try {
+    scene::load_scene(f, {"body.0.width=0.7"});
+    ADD_FAILURE() << "a wheel wider than the walled bed";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("body[0].width"), std::string::npos) << e.what();
+  }
+}
+
 TEST(SceneConfig, BodyErrorsNameTheKeyAndRule) {
   EXPECT_NE(intrusion_error("density = 2700.0", "density = -1.0").find("body[0].density"), std::string::npos);
   // Names become folders and HDF5 groups: refused at load time, before any output.
@@ -228,7 +256,8 @@ TEST(SceneConfig, BodyErrorsNameTheKeyAndRule) {
   EXPECT_NE(
       intrusion_error("kind = \"intrusion\"", "kind = \"intrusion\"\nbody = \"rod\"").find("no [[body]] has that name"),
       std::string::npos);
-  EXPECT_NE(intrusion_error("kind = \"intrusion\"", "kind = \"wheel\"").find("plane-strain grid"), std::string::npos);
+  EXPECT_NE(intrusion_error("kind = \"intrusion\"", "kind = \"wheel\"").find("plane-strain or 3D grid"),
+            std::string::npos);
   EXPECT_NE(intrusion_error("name = \"intruder\"", "name = \"grains\"").find("differ from the phases"),
             std::string::npos);
   EXPECT_NE(intrusion_error("shape = \"box\"", "shape = \"cylinder\"").find("cylinders are 3D bodies"),

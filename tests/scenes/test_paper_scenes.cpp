@@ -340,6 +340,31 @@ TEST(PaperScenes, Rod3dCylinderHasTheVolumeCentroidAndLowestPointOfItsShape) {
   EXPECT_GE(zmin, 0.1 - 1e-12);
 }
 
+TEST(PaperScenes, WidthPeriodicWheel3dIsThePlaneStrainWheel) {
+  // S4 in the 3D solver, bed and wheel periodic across the width (wheel_3d.toml's width_periodic)
+  // against wheel.toml in plane strain, 60 x 30 cells (4 across the width), 100 steps: every
+  // field is uniform along y, so the two solve one problem; the hub's height, distance and the
+  // motor's measured omega agree to round-off. (Contact force: plane strain per metre of depth.)
+  clitest::TempDir d;
+  const auto ps = run_paper_scene("wheel.toml", d / "ps",
+                                  {"cells=[60, 30]", "duration=0.002", "analysis.snapshot_times=[]",
+                                   "output.frame_interval=0", "analysis.sample_interval=0.001"});
+  const auto w3 = run_paper_scene("wheel_3d.toml", d / "w3",
+                                  {"width_periodic=true", "cells=[60, 4, 30]", "duration=0.002",
+                                   "output.frame_interval=0", "analysis.sample_interval=0.001"});
+  ASSERT_EQ(ps["steps"], w3["steps"]);
+  EXPECT_NEAR(w3["hub_height_final"].get<double>(), ps["hub_height_final"].get<double>(), 1e-12);
+  // distance: a fraction of a micrometre after 100 steps
+  EXPECT_NEAR(w3["distance"].get<double>(), ps["distance"].get<double>(), 1e-12);
+  EXPECT_GT(std::fabs(ps["distance"].get<double>()), 1e-9);
+  const auto wp = ps["omega_measured"]["value"].get<std::vector<double>>();
+  const auto w = w3["omega_measured"]["value"].get<std::vector<double>>();
+  ASSERT_EQ(w.size(), wp.size());
+  for (std::size_t k = 0; k < w.size(); ++k) EXPECT_NEAR(w[k], wp[k], 1e-12) << k;
+  const double width = w3["bodies"]["wheel"]["mass"].get<double>() / ps["bodies"]["wheel"]["mass"].get<double>();
+  EXPECT_NEAR(width, 2.0 / 15.0, 1e-12);  // the slab's width [m]: the 3D wheel is that much plane-strain wheel
+}
+
 TEST(PaperScenes, RodRunRestartsBitForBit) {
   // A free rigid body's velocity, its contact impulse sum and the analysis track are part of the
   // checkpoint: an interrupted rod run continues exactly.

@@ -143,12 +143,14 @@ struct ContactPair {
 };
 
 /// Velocity-level motor (model.md §8, wheel): before each step, the mean angular velocity of the
-/// body about its centre of mass, ω̄ = Σ m (x − x_c) × (v − V_c) / Σ m |x − x_c|², is moved to the
-/// target by a rigid rotation increment Δω = gain (ω* − ω̄) of every point's velocity,
-/// v_p += Δω ẑ × (x_p − x_c) (and the APIC matrix C_p += Δω [[0, −1], [1, 0]], the gradient of that
-/// increment). Σ m (x − x_c) = 0, so the linear momentum (translation) is untouched: the body is
-/// free to translate, fall, roll. The motor torque is I Δω/Δt (plane strain: per unit depth).
-/// Plane strain only.
+/// body about its centre of mass in the plane of the first and the last axis (plane strain: x, y;
+/// 3D: x, z, the rotation about the y axis, counter-clockwise from +x towards +z, as in plane
+/// strain), ω̄ = Σ m (x − x_c) × (v − V_c) / Σ m |x − x_c|² with both vectors taken in that plane,
+/// is moved to the target by a rigid rotation increment Δω = gain (ω* − ω̄) of every point's
+/// velocity in the plane, v_p += Δω (−r_2, r_1) (r = x_p − x_c; the APIC matrix C_p gains the
+/// gradient of that increment, Δω [[0, −1], [1, 0]] on the plane's components). Σ m (x − x_c) = 0,
+/// so the linear momentum (translation) is untouched: the body is free to translate, fall, roll.
+/// The motor torque is I Δω/Δt (plane strain: per unit depth). Plane strain and 3D.
 template <class G>
 struct Motor {
   int body = -1;
@@ -189,40 +191,42 @@ Vec<G::dim> body_reference(const Body<G>& body, bool across_ranks) {
   return x0;
 }
 
-/// Mean angular velocity, centre and inertia of a plane body (see Motor), positions unwrapped
-/// about body_reference on periodic axes (`grid`: the global grid); sums over every rank's points
-/// when `across_ranks`.
+/// Mean angular velocity, centre and inertia of a body in the plane of the first and last axes
+/// (see Motor), positions unwrapped about body_reference on periodic axes (`grid`: the global
+/// grid); sums over every rank's points when `across_ranks`. `centre`, `velocity`: the centre of
+/// mass and the mean velocity (every component).
 template <class G>
 void angular_state(const Body<G>& body, const Grid<G::dim>& grid, bool across_ranks, double& omega, double& inertia,
                    Vec<G::dim>& centre, Vec<G::ncomp>& velocity) {
-  static_assert(G::dim == 2 && G::ncomp == 2, "angular_state: plane strain only");
+  constexpr int D = G::dim, NC = G::ncomp, a = 0, b = D - 1;
+  static_assert(D == NC, "angular_state: plane strain and 3D (not axisymmetric)");
   const std::int64_t np = body.size();
   omega = inertia = 0.0;
   centre.setZero();
   velocity.setZero();
-  const Vec<2> x0 = body_reference(body, across_ranks);
-  if (!std::isfinite(x0[0])) return;            // no points
-  double first[5] = {0.0, 0.0, 0.0, 0.0, 0.0};  // M, Σ m (x − x0), Σ m v
+  const Vec<D> x0 = body_reference(body, across_ranks);
+  if (!std::isfinite(x0[0])) return;       // no points
+  std::array<double, 1 + D + NC> first{};  // M, Σ m (x − x0), Σ m v
   for (std::int64_t p = 0; p < np; ++p) {
     const double m = body.mass_kg[p];
-    const Vec<2> d = m * periodic_difference<2>(grid, body.x_m[p], x0), mv = m * body.v_m_s[p];
+    const Vec<D> d = m * periodic_difference<D>(grid, body.x_m[p], x0);
+    const Vec<NC> mv = m * body.v_m_s[p];
     first[0] += m;
-    first[1] += d[0];
-    first[2] += d[1];
-    first[3] += mv[0];
-    first[4] += mv[1];
+    for (int k = 0; k < D; ++k) first[1 + k] += d[k];
+    for (int k = 0; k < NC; ++k) first[1 + D + k] += mv[k];
   }
   if (across_ranks) comm::sum_ordered(first);
   const double M = first[0];
-  const Vec<2> dc = Vec<2>(first[1], first[2]) / M;
-  velocity = Vec<2>(first[3], first[4]) / M;
-  double second[2] = {0.0, 0.0};  // Σ m r × u, Σ m |r|²
+  Vec<D> dc;
+  for (int k = 0; k < D; ++k) dc[k] = first[1 + k] / M;
+  for (int k = 0; k < NC; ++k) velocity[k] = first[1 + D + k] / M;
+  std::array<double, 2> second{};  // Σ m r × u, Σ m |r|² in the plane
   for (std::int64_t p = 0; p < np; ++p) {
     const double m = body.mass_kg[p];
-    const Vec<2> r = periodic_difference<2>(grid, body.x_m[p], x0) - dc;
-    const Vec<2> u = body.v_m_s[p] - velocity;
-    second[0] += m * (r[0] * u[1] - r[1] * u[0]);
-    second[1] += m * r.squaredNorm();
+    const Vec<D> r = periodic_difference<D>(grid, body.x_m[p], x0) - dc;
+    const Vec<NC> u = body.v_m_s[p] - velocity;
+    second[0] += m * (r[a] * u[b] - r[b] * u[a]);
+    second[1] += m * (r[a] * r[a] + r[b] * r[b]);
   }
   if (across_ranks) comm::sum_ordered(second);
   inertia = second[1];
@@ -234,16 +238,20 @@ void angular_state(const Body<G>& body, const Grid<G::dim>& grid, bool across_ra
 /// Apply one motor correction (see Motor) to its body before the step (`grid`: the global grid).
 template <class G>
 void apply_motor(Motor<G>& motor, Body<G>& body, const Grid<G::dim>& grid, bool across_ranks, double dt_s) {
-  Vec<2> centre, V;
+  constexpr int D = G::dim, NC = G::ncomp, a = 0, b = D - 1;
+  Vec<D> centre;
+  Vec<NC> V;
   double omega = 0.0, inertia = 0.0;
   angular_state(body, grid, across_ranks, omega, inertia, centre, V);
   const double dw = motor.gain * (motor.omega_rad_s - omega);
   const std::int64_t np = body.size();
-  Mat<2, 2> dC;
-  dC << 0.0, -dw, dw, 0.0;
+  Mat<NC, NC> dC = Mat<NC, NC>::Zero();
+  dC(a, b) = -dw;
+  dC(b, a) = dw;
   for (std::int64_t p = 0; p < np; ++p) {
-    const Vec<2> r = periodic_difference<2>(grid, body.x_m[p], centre);
-    body.v_m_s[p] += dw * Vec<2>(-r[1], r[0]);
+    const Vec<D> r = periodic_difference<D>(grid, body.x_m[p], centre);
+    body.v_m_s[p][a] -= dw * r[b];
+    body.v_m_s[p][b] += dw * r[a];
     body.C_1_s[p] += dC;
   }
   motor.omega_measured_rad_s = omega;

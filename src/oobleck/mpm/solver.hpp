@@ -202,11 +202,11 @@ class Solver {
       if (c.solid == b) F += c.force_N;
     return F;
   }
-  /// Velocity-level motor holding the mean angular velocity ω of body b (plane strain; see
+  /// Velocity-level motor holding the mean angular velocity ω of body b (plane strain and 3D; see
   /// contact.hpp). Returns the motor index.
   int add_motor(int b, double omega_rad_s, double gain = 1.0) {
-    if constexpr (!std::is_same_v<G, PlaneStrain>) {
-      throw InputError("mpm: motors are implemented in plane strain only");
+    if constexpr (std::is_same_v<G, Axisymmetric>) {
+      throw InputError("mpm: motors are implemented in plane strain and 3D only");
     } else {
       check_solid(b, "motor");
       if (rigid_[b].rigid()) throw InputError("mpm: a motor drives a deformable body");
@@ -725,7 +725,7 @@ class Solver {
   }
 
   void apply_motors() {
-    if constexpr (std::is_same_v<G, PlaneStrain>)
+    if constexpr (!std::is_same_v<G, Axisymmetric>)
       for (auto& m : motors_) apply_motor(m, *bodies_[m.body], global_grid(), dec_ != nullptr, opt_.dt_s);
   }
 

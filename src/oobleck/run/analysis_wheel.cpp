@@ -1,6 +1,7 @@
 // [analysis] kind = "wheel" (S4, scenes.md; docs/analysis.md "Wheel"): the hub's height and the
 // distance travelled along the periodic track, the motor's measured ω, and at every frame the
 // point-to-point scatter of the grains' pressure under the wheel (the SI's ringing figure).
+// Plane strain (x, y) and 3D (x, z: the height is the last axis; the scatter pools every y).
 #include <cmath>
 
 #include "oobleck/analysis/summary_json.hpp"
@@ -39,7 +40,7 @@ class WheelAnalysis final : public SceneAnalysis<G> {
       std::vector<double> px, py, pp;
       for (std::int64_t p = 0; p < gb.size(); ++p) {
         px.push_back(gb.x_m[p][0]);
-        py.push_back(gb.x_m[p][1]);
+        py.push_back(gb.x_m[p][D - 1]);  // 3D: (x, z), every y
         pp.push_back(-gb.stress_Pa[p].trace() / 3.0);
       }
       const auto r = analysis::pressure_scatter(px, py, pp, window);
@@ -123,7 +124,7 @@ nlohmann::json WheelAnalysis<G>::result() const {
   for (const auto& t : track) {
     hub.time_s.push_back(t.t);
     hub.x_m.push_back(t.centre[0]);
-    hub.y_m.push_back(t.centre[1]);
+    hub.y_m.push_back(t.centre[D - 1]);
   }
   analysis::WheelCriteria wc;
   wc.track_length_m = cfg_.grid.size_m[0];
@@ -136,7 +137,7 @@ nlohmann::json WheelAnalysis<G>::result() const {
   analysis::TimeSeries height, dist, om;
   for (std::size_t k = 0; k < track.size(); ++k) {
     height.time.push_back(track[k].t);
-    height.value.push_back(track[k].centre[1]);
+    height.value.push_back(track[k].centre[D - 1]);
     dist.time.push_back(track[k].t);
     dist.value.push_back(wc.forward * (sum.x_unwrapped_m[k] - sum.x_unwrapped_m[0]));
     om.time.push_back(track[k].t);

@@ -5,7 +5,6 @@
 // 4 + D + 2 NC numbers per sample), "analysis/track_impulse" and the attribute "track_time".
 #include <algorithm>
 #include <cmath>
-#include <type_traits>
 #include <vector>
 
 #include "oobleck/mpm/fields.hpp"
@@ -48,11 +47,9 @@ class BodyTrack {
     s.force = s.t > time_ ? Vn((J - impulse_) / (s.t - time_)) : Vn(solver.contact(tb.pair).force_N);
     impulse_ = J;
     time_ = s.t;
-    if constexpr (std::is_same_v<G, mpm::PlaneStrain>) {
-      if (tb.motor >= 0) {
-        s.omega = solver.motor(tb.motor).omega_measured_rad_s;
-        s.torque = solver.motor(tb.motor).torque_N_m;
-      }
+    if (tb.motor >= 0) {
+      s.omega = solver.motor(tb.motor).omega_measured_rad_s;
+      s.torque = solver.motor(tb.motor).torque_N_m;
     }
     track_.push_back(s);
   }

@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <optional>
-#include <type_traits>
 #include <variant>
 
 #include <fmt/format.h>
@@ -193,10 +192,8 @@ std::vector<double> series_row(const scene::BuiltScene<G>& scene) {
     const mpm::Vec<NC> F = solver.contact(tb.pair).force_N;
     for (int k = 0; k < NC; ++k) r.push_back(F[k]);
     if (tb.motor >= 0) {
-      if constexpr (std::is_same_v<G, mpm::PlaneStrain>) {
-        r.push_back(solver.motor(tb.motor).omega_measured_rad_s);
-        r.push_back(solver.motor(tb.motor).torque_N_m);
-      }
+      r.push_back(solver.motor(tb.motor).omega_measured_rad_s);
+      r.push_back(solver.motor(tb.motor).torque_N_m);
     }
   }
   return r;

@@ -432,10 +432,16 @@ void read_body_shape(io::TomlReader& r, const SceneConfig& c, BodyConfig& b) {
     }
     return;
   }
-  if (c.grid.geometry != Geometry::PlaneStrain) {
-    r.fail("shape", "discs and wheels are plane-strain bodies (use a box: a cylinder on the axis)");
+  if (c.grid.geometry == Geometry::Axisymmetric) {
+    r.fail("shape", "discs and wheels are plane-strain or 3D bodies (axisymmetric: a box from r = 0 is a cylinder)");
   }
   b.centre_m = read_vec(r, "centre", dim, {0, 0, 0}, true);
+  if (dim == 3) {  // in the (x, z) plane, the axle along y
+    b.width_m = r.number("width");
+    r.require(b.width_m > 0, "width", b.width_m, "must be positive [m] (the extent along y)");
+    if (!(c.boundary[2].type == BoundaryType::Periodic))
+      inside_grid("width", b.centre_m[1] - 0.5 * b.width_m, b.centre_m[1] + 0.5 * b.width_m, 1);
+  }
   double R = 0.0;
   if (b.shape == BodyShape::Disc) {
     b.radius_m = r.number("radius");
@@ -455,7 +461,7 @@ void read_body_shape(io::TomlReader& r, const SceneConfig& c, BodyConfig& b) {
     b.paddles = static_cast<int>(np);
     R = b.hub_radius_m + b.paddle_length_m;
   }
-  for (int a = 0; a < dim; ++a) {
+  for (int a = 0; a < dim; a += dim - 1) {  // the plane of the disc or wheel: x and the last axis
     if (!(c.boundary[2 * a].type == BoundaryType::Periodic))
       inside_grid("centre", b.centre_m[a] - R, b.centre_m[a] + R, a);
   }
@@ -482,8 +488,8 @@ void read_body_material(io::TomlReader& r, const SceneConfig& c, BodyConfig& b) 
     b.motor_omega_rad_s = r.optional_number("motor_omega");
     b.motor_gain = r.number_or("motor_gain", 1.0);
     r.require(b.motor_gain > 0 && b.motor_gain <= 1, "motor_gain", b.motor_gain, "must lie in (0, 1]");
-    if (b.motor_omega_rad_s && c.grid.geometry != Geometry::PlaneStrain) {
-      r.fail("motor_omega", "motors are implemented in plane strain only");
+    if (b.motor_omega_rad_s && c.grid.geometry == Geometry::Axisymmetric) {
+      r.fail("motor_omega", "motors are implemented in plane strain and 3D only");
     }
   } else {
     for (const char* k : {"youngs_modulus", "poisson_ratio", "motor_omega", "motor_gain"}) {
@@ -628,8 +634,8 @@ void check_analysis_body(io::TomlReader& an, const SceneConfig& c, AnalysisConfi
     an.fail("kind", "\"rod\" needs a free rigid body (motion = \"free\")");
   }
   if (analysis.kind == AnalysisKind::Wheel &&
-      !(c.grid.geometry == Geometry::PlaneStrain && target->motion == BodyMotionKind::Elastic)) {
-    an.fail("kind", "\"wheel\" needs a plane-strain grid and an elastic body");
+      !(c.grid.geometry != Geometry::Axisymmetric && target->motion == BodyMotionKind::Elastic)) {
+    an.fail("kind", "\"wheel\" needs a plane-strain or 3D grid and an elastic body");
   }
 }
 
@@ -677,6 +683,33 @@ std::map<std::string, std::string> read_aliases(const toml::table& root, const s
   return aliases;
 }
 
+/// [variants]: named bundles of overrides, `name = ["key=value", ...]` (keys as --set takes them,
+/// aliases included), applied in their order by `--set name=true`; `--set name=false` applies
+/// nothing. A variant may not share its name with an alias.
+std::map<std::string, std::vector<std::string>> read_variants(const toml::table& root, const std::string& path,
+                                                              const std::map<std::string, std::string>& aliases) {
+  std::map<std::string, std::vector<std::string>> variants;
+  const auto* vt = root.get_as<toml::table>("variants");
+  if (vt == nullptr) return variants;
+  for (const auto& [k, v] : *vt) {
+    const std::string name(k.str());
+    auto fail = [&](const std::string& why) {
+      throw InputError(fmt::format("{}: key 'variants.{}': {}", path, name, why));
+    };
+    if (aliases.count(name) != 0) fail("is also an alias; give the variant another name");
+    const auto* arr = v.as_array();
+    if (arr == nullptr) fail("must be an array of \"key=value\" strings");
+    auto& specs = variants[name];
+    for (const auto& e : *arr) {
+      const auto spec = e.value<std::string>();
+      if (!spec || spec->find('=') == std::string::npos || spec->front() == '=')
+        fail("must be an array of \"key=value\" strings");
+      specs.push_back(*spec);
+    }
+  }
+  return variants;
+}
+
 template <class E, std::size_t N>
 const char* name_of(E e, const std::array<std::pair<const char*, E>, N>& names) {
   for (const auto& [n, v] : names) {
@@ -719,7 +752,22 @@ SceneConfig load_scene(const std::string& path, const std::vector<std::string>& 
   c.file = path;
   // Aliases first: they give --set its short names.
   c.aliases = read_aliases(root, path);
-  for (const auto& o : overrides) apply_override(root, path, o, c.aliases);
+  const auto variants = read_variants(root, path, c.aliases);
+  for (const auto& o : overrides) {
+    const auto eq = o.find('=');
+    const auto variant = eq == std::string::npos ? variants.end() : variants.find(o.substr(0, eq));
+    if (variant == variants.end()) {
+      apply_override(root, path, o, c.aliases);
+      continue;
+    }
+    const std::string value = o.substr(eq + 1);
+    if (value != "true" && value != "false") {
+      throw InputError(
+          fmt::format("--set {}: '{}' is a variant of {}: it takes true or false", o, variant->first, path));
+    }
+    if (value == "true")
+      for (const auto& spec : variant->second) apply_override(root, path, spec, c.aliases);
+  }
   {
     std::ostringstream resolved;
     resolved << root;
@@ -727,6 +775,7 @@ SceneConfig load_scene(const std::string& path, const std::vector<std::string>& 
   }
   io::TomlReader top(root, path);
   (void)top.optional_table("aliases");
+  (void)top.optional_table("variants");
   // The sections in this order: each reader may use what the ones before it read (the bodies
   // the boundary, the analysis the bodies and the duration).
   read_scene(top, c);

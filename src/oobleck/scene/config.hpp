@@ -90,6 +90,7 @@ struct BodyConfig {
   double paddle_length_m = 0.0;  ///< [m] paddle length beyond the hub (tip radius = hub + paddle)
   double paddle_width_m = 0.0;   ///< [m] paddle width
   int paddles = 4;               ///< number of paddles (spokes)
+  double width_m = 0.0;          ///< [m] disc or wheel on a 3D grid: its extent along y (its axle)
   double angle_deg = 0.0;        ///< [deg] angle of the first paddle from +x
   BodyMotionKind motion = BodyMotionKind::Prescribed;
   std::array<double, 3> velocity_m_s{0, 0,
@@ -102,7 +103,7 @@ struct BodyConfig {
   double poisson_ratio = 0.3;               ///< [-] elastic bodies
   int points_per_cell = 2;                  ///< per axis
   double friction = 0.0;                    ///< [-] Coulomb coefficient between body and grains
-  std::optional<double> motor_omega_rad_s;  ///< [rad/s] motor target ω (elastic, plane strain)
+  std::optional<double> motor_omega_rad_s;  ///< [rad/s] motor target ω (elastic; plane strain or 3D)
   double motor_gain = 1.0;                  ///< [-] fraction of the ω error removed per step
 };
 

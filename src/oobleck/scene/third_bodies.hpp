@@ -29,7 +29,9 @@ bool inside_body(const scene::BodyConfig& b, const mpm::Vec<D>& x) {
       return true;
     case scene::BodyShape::Disc:
     case scene::BodyShape::Wheel: {
-      const double dx = x[0] - b.centre_m[0], dy = x[1] - b.centre_m[1];
+      // In the plane of x and the last axis; 3D: `width` along y, the axle.
+      if (D == 3 && std::fabs(x[1] - b.centre_m[1]) > 0.5 * b.width_m) return false;
+      const double dx = x[0] - b.centre_m[0], dy = x[D - 1] - b.centre_m[D - 1];
       const double r2 = dx * dx + dy * dy;
       if (b.shape == scene::BodyShape::Disc) return r2 <= b.radius_m * b.radius_m;
       if (r2 <= b.hub_radius_m * b.hub_radius_m) return true;
@@ -81,8 +83,9 @@ void body_bounds(const scene::BodyConfig& b, mpm::Vec<D>& lo, mpm::Vec<D>& hi) {
   }
   const double R = b.shape == scene::BodyShape::Disc ? b.radius_m : b.hub_radius_m + b.paddle_length_m;
   for (int a = 0; a < D; ++a) {
-    lo[a] = b.centre_m[a] - R;
-    hi[a] = b.centre_m[a] + R;
+    const double half = D == 3 && a == 1 ? 0.5 * b.width_m : R;  // 3D: the width along the axle
+    lo[a] = b.centre_m[a] - half;
+    hi[a] = b.centre_m[a] + half;
   }
 }
 
