@@ -1,6 +1,6 @@
 #!/bin/bash
 # Scaling of decomposed runs (docs/mpi.md "Scaling"). Strong: bench/scenes/mpi_3d.toml (1.03e6
-# points, 50 steps) on 1 and 2 ranks of 1 thread, interleaved round by round, and the gain of each
+# points of a moving bed and a rigid cylinder pushed into it, 50 steps) on 1 and 2 ranks of 1 thread, interleaved round by round, and the gain of each
 # round as the ratio of the step rates (points x steps / the step's wall time, summary.json
 # timings_seconds; the first and last frames, gathered on rank 0, are not part of the step).
 # Weak: the bed widened along x with the ranks (points per rank fixed) on 1, 2 and 4 ranks
