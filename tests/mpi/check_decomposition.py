@@ -139,6 +139,7 @@ def compare(ref, run, label, settling_tol=1e-9, field_tol=1e-10):
         scale = ra[f"mass_{body}"] * max(ra[f"max_speed_{body}"], 1e-300)  # |P| <= M max|v|
         rel = np.abs(pb - pa).max() / scale
         check(rel <= 1e-12, f"{label}: momentum of {body} within {rel:.1e} of M max|v| (<= 1e-12)")
+    compare_snapshots(ref, run, label, field_tol)
     fa, fb = final_frame(ref), final_frame(run)
     for body in fa:
         xa, xb = fa[body]["position"], fb[body]["position"]
@@ -154,6 +155,66 @@ def compare(ref, run, label, settling_tol=1e-9, field_tol=1e-10):
             rel = np.abs(B - A).max() / scale
             check(rel <= field_tol, f"{label}: {body} {k} after {a['steps']} steps: {rel:.1e} of its largest magnitude "
                                     f"(<= {field_tol:g})")
+
+
+def compare_snapshots(ref, run, label, field_tol):
+    """The nodal snapshots (snapshot_<k>.csv): the same files, every column within field_tol of
+    its largest magnitude plus the rounding of the file's 9 significant digits."""
+    files = sorted(os.path.basename(f) for f in glob.glob(os.path.join(ref, "snapshot_*.csv")))
+    other = sorted(os.path.basename(f) for f in glob.glob(os.path.join(run, "snapshot_*.csv")))
+    check(files == other, f"{label}: snapshots {other} = {files}")
+    for name in files:
+        if name not in other:
+            continue
+        A = np.loadtxt(os.path.join(ref, name), delimiter=",", skiprows=2, ndmin=2)
+        B = np.loadtxt(os.path.join(run, name), delimiter=",", skiprows=2, ndmin=2)
+        if A.shape != B.shape:
+            check(False, f"{label}: {name}: shape {B.shape} = {A.shape}")
+            continue
+        scale = np.maximum(np.abs(A).max(axis=0), 1e-300)
+        excess = (np.abs(B - A) - 1.01e-8 * np.abs(A)) / scale
+        check(excess.max() <= field_tol, f"{label}: {name} ({A.shape[0]} nodes): largest difference "
+                                         f"{(np.abs(B - A) / scale).max():.1e} of its column's largest magnitude "
+                                         f"(<= {field_tol:g} beyond the 9 digits' rounding)")
+
+
+def compare_analysis(ref, run, label, keys, tol=1e-10):
+    """Numbers of summary.json's analysis entries `keys` (nested lists and objects): each within
+    tol of the largest magnitude of the list or object that holds it."""
+    a, b = summary(ref), summary(run)
+    worst = [0.0, ""]
+
+    def walk(x, y, path, scale):
+        if isinstance(x, dict):
+            nums = [abs(v) for v in x.values() if isinstance(v, (int, float)) and not isinstance(v, bool)]
+            inner = max(nums, default=0.0)
+            for k in x:
+                if k not in y:
+                    check(False, f"{label}: {path}/{k} missing")
+                    continue
+                walk(x[k], y[k], f"{path}/{k}", inner)
+        elif isinstance(x, list):
+            if len(x) != len(y):
+                check(False, f"{label}: {path}: {len(y)} entries, expected {len(x)}")
+                return
+            nums = [abs(v) for v in x if isinstance(v, (int, float)) and not isinstance(v, bool)]
+            inner = max(nums, default=scale)
+            for i, (u, v) in enumerate(zip(x, y)):
+                walk(u, v, f"{path}[{i}]", inner)
+        elif isinstance(x, (int, float)) and not isinstance(x, bool) and isinstance(y, (int, float)):
+            rel = abs(y - x) / max(abs(x), scale, 1e-300)
+            if rel > worst[0]:
+                worst[:] = [rel, path]
+        else:
+            check(x == y, f"{label}: {path} = {y!r}, expected {x!r}")
+
+    for key in keys:
+        if key not in a:
+            check(False, f"{label}: the one-rank summary has no '{key}'")
+            continue
+        walk(a[key], b.get(key), key, 0.0)
+    check(worst[0] <= tol, f"{label}: {', '.join(keys)}: largest difference {worst[0]:.1e} (at {worst[1] or '-'}) "
+                           f"of its entry or list (<= {tol:g})")
 
 
 def case_settling_3d(work):
@@ -223,14 +284,16 @@ def case_couette_axisym(work):
              [(2, 1, None, False), (3, 1, "3x1", False), (2, 1, "1x2", False)])
 
 
-# The paper's scenes with third bodies, coarse and short (a few hundred steps, no snapshots).
+# The paper's scenes with third bodies, coarse and short (a few hundred steps), with their nodal
+# snapshots (2D: intrusion, rod, wheel) at two times.
 THIRD_BODY_SCENES = {
     # S3: the prescribed intruder (axisymmetric), 1 mm, 200 steps; its fronts' fields sampled twice.
-    "intrusion": ("scenes/paper/intrusion.toml", ["--set", "duration=0.0002", "--set", "analysis.snapshot_times=[]",
+    "intrusion": ("scenes/paper/intrusion.toml", ["--set", "duration=0.0002",
+                                                  "--set", "analysis.snapshot_times=[0.0001, 0.0002]",
                                                   "--set", "output.frame_interval=0.0001"]),
     # S2: the free rod (axisymmetric), 4 mm cells, 300 steps.
     "rod": ("scenes/paper/rod_impact.toml", ["--set", "cell_size=0.004", "--set", "duration=0.0012",
-                                             "--set", "analysis.snapshot_times=[]",
+                                             "--set", "analysis.snapshot_times=[0.0006, 0.0012]",
                                              "--set", "output.frame_interval=0.0006"]),
     # S2 in 3D: the rod tilted by 30 deg (an oblique launch at 2 m/s), 10 mm cells, the container
     # narrowed to 10 cm, 168 steps; the rod straddles the cuts at x = 0 and y = 0. (Two points per
@@ -246,7 +309,8 @@ THIRD_BODY_SCENES = {
                                                    "--set", "output.frame_interval=0.001"]),
     # S4: the elastic wheel with its motor (plane strain, periodic track), 60 x 30 cells, 400 steps.
     "wheel": ("scenes/paper/wheel.toml", ["--set", "cells=[60, 30]", "--set", "duration=0.008",
-                                          "--set", "analysis.snapshot_times=[]", "--set", "output.frame_interval=0.004",
+                                          "--set", "analysis.snapshot_times=[0.004, 0.008]",
+                                          "--set", "output.frame_interval=0.004",
                                           "--set", "analysis.sample_interval=0.002"]),
     # S4 in 3D, width-periodic (the plane-strain wheel in the 3D solver), 33 mm cells, 200 steps.
     "wheel_3d": ("scenes/paper/wheel_3d.toml", ["--set", "width_periodic=true", "--set", "cells=[60, 4, 30]",
@@ -296,6 +360,27 @@ def case_wheel_3d(work):
 
 def case_wheel(work):
     case_third_bodies(work, "wheel", [(2, 1, "2x1"), (3, 1, "3x1"), (2, 2, "1x2")])
+
+
+def case_annular(work):
+    """S1, the annular cell (axisymmetric with swirl, its bob turning the bed), 2 000 steps: the
+    run against one rank, and the annular measurement (profiles, fronts) from every rank's nodes
+    and points; split radially, axially and both, and with 2 threads per rank."""
+    scene = os.path.join(ROOT, "scenes/paper/annular_shear.toml")
+    extra = ["--set", "duration=0.02", "--set", "output.frame_interval=0.01"]
+    ref = os.path.join(work, "annular_np0")
+    shutil.rmtree(ref, ignore_errors=True)
+    rc, err = oobleck([scene, "--out", ref] + extra, 0)
+    check(rc == 0, f"annular: one-rank run, exit status {rc}" + ("" if rc == 0 else f"\n{err[-2000:]}"))
+    for ranks, threads, grid in [(2, 1, "1x2"), (3, 1, "3x1"), (2, 2, "2x1")]:
+        tag = f"np{ranks}_t{threads}_{grid}"
+        out = os.path.join(work, f"annular_{tag}")
+        shutil.rmtree(out, ignore_errors=True)
+        rc, err = oobleck([scene, "--out", out, "--ranks-grid", grid] + extra, ranks, threads)
+        check(rc == 0, f"annular {tag}: exit status {rc}" + ("" if rc == 0 else f"\n{err[-2000:]}"))
+        if rc == 0 and not failures:
+            compare(ref, out, f"annular {tag}")
+            compare_analysis(ref, out, f"annular {tag}", ["profiles", "front", "structure_front", "outer_rotation"])
 
 
 def case_restart(work):
@@ -382,19 +467,14 @@ def case_bad_input(work):
     expect_refused(work, "bad_too_many_ranks", [], 7, "the grid (4x4x20 cells) is too small")
     expect_refused(work, "bad_grid_one_rank", ["--ranks-grid", "1x1x2"], 0, "this run has 1 (start it with mpirun -np 2)")
     expect_refused(work, "bad_grid_syntax", ["--ranks-grid", "2x"], 2, "expected 3 positive factors")
-    annular = os.path.join(ROOT, "scenes/paper/annular_shear.toml")
-    out = os.path.join(work, "bad_annular")
-    shutil.rmtree(out, ignore_errors=True)
-    rc, err = oobleck([annular, "--out", out], 2)
-    check(rc != 0 and "does not run decomposed yet" in err, f"bad_annular: refused (status {rc})")
-    check(not os.path.exists(out), "bad_annular: no run folder written")
 
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser()
     ap.add_argument("--oobleck", required=True)
     ap.add_argument("--case", required=True, choices=["settling_3d", "settling_2d", "crossing_2d", "crossing_3d", "couette_axisym", "restart",
-                                                      "bad_input", "killed_rank", "intrusion", "rod", "rod_3d", "wheel", "wheel_3d"])
+                                                      "bad_input", "killed_rank", "intrusion", "rod", "rod_3d", "wheel", "wheel_3d",
+                                                      "annular"])
     ap.add_argument("--work", required=True)
     args = ap.parse_args()
     BIN = os.path.abspath(args.oobleck)

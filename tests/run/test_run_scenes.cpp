@@ -1,10 +1,14 @@
 // `oobleck run` end to end on the verification scenes: the measured quantity written into
 // summary.json against its analytic value (V3 torque, V4 settling), exact mass conservation,
 // restart equality, and refusal of invalid scenes before any output.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <functional>
 #include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -38,13 +42,15 @@ double rel(double a, double b) { return std::fabs(a - b) / std::fabs(b); }
 /// 150 ("part"), its checkpoint passed to `edit` (the path), then restarted to the end. Returns the
 /// two checkpoints of step 300.
 std::pair<io::Checkpoint, io::Checkpoint> restarted_settling(const clitest::TempDir& d,
-                                                             const std::function<void(const std::string&)>& edit) {
+                                                             const std::function<void(const std::string&)>& edit,
+                                                             std::vector<std::string> overrides = {}) {
   run::RunOptions o;
   o.checkpoint_every = 100;
   o.threads = 1;
-  run_verification("settling.toml", d / "full", {"time.duration=0.01"}, o);  // 359 steps, checkpoint at 300
+  overrides.insert(overrides.begin(), "time.duration=0.01");
+  run_verification("settling.toml", d / "full", overrides, o);  // 359 steps, checkpoint at 300
   o.stop_after_steps = 150;
-  run_verification("settling.toml", d / "part", {"time.duration=0.01"}, o);  // stops at 150 with a checkpoint
+  run_verification("settling.toml", d / "part", overrides, o);  // stops at 150 with a checkpoint
   edit(run::checkpoint_path(d / "part"));
   o.stop_after_steps = -1;
   o.restart = true;
@@ -52,6 +58,31 @@ std::pair<io::Checkpoint, io::Checkpoint> restarted_settling(const clitest::Temp
   o.quiet = true;
   run::run_scene(scene::load_scene(run::stored_scene_path(d / "part")), o);
   return {io::read_checkpoint(run::checkpoint_path(d / "full")), io::read_checkpoint(run::checkpoint_path(d / "part"))};
+}
+
+/// Rewrite the settling scene's checkpoint `path` as an older version wrote it: every attribute
+/// and array kept, except that `older(name, values)` may rename an array and change its values
+/// (it returns the name to store them under).
+void rewrite_as_older(const std::string& path,
+                      const std::function<std::string(const std::string&, std::vector<double>&)>& older) {
+  const auto cp = io::read_checkpoint(path);
+  io::CheckpointWriter w(path);
+  w.set_step(cp.step());
+  w.set_time(cp.time());
+  w.set_config(cp.config());
+  w.attribute("dt", cp.real_attribute("dt"));
+  w.attribute("settle_sum", cp.real_attribute("settle_sum"));
+  for (const char* k : {"threads", "settle_samples", "next_snapshot"}) w.attribute(k, cp.int_attribute(k));
+  for (const auto& n : cp.names()) {
+    if (n == "granular/regime") {
+      w.array(n, cp.bytes(n), cp.shape(n));
+      continue;
+    }
+    std::vector<double> values = cp.doubles(n);
+    const std::string name = older(n, values);
+    w.array(name, values, cp.shape(n));
+  }
+  w.commit();
 }
 }  // namespace
 
@@ -128,28 +159,12 @@ TEST(RunScenes, RestartReadsAnOlderCheckpointWithJ) {
   // file restarts through the logarithm, and the run continues within that logarithm's round-off.
   clitest::TempDir d;
   const auto [a, b] = restarted_settling(d, [](const std::string& path) {
-    // The part's checkpoint rewritten in the older form: every array and attribute, J for ln J.
-    const auto cp = io::read_checkpoint(path);
-    ASSERT_TRUE(cp.has("fluid/ln_J"));
-    io::CheckpointWriter w(path);
-    w.set_step(cp.step());
-    w.set_time(cp.time());
-    w.set_config(cp.config());
-    w.attribute("dt", cp.real_attribute("dt"));
-    w.attribute("settle_sum", cp.real_attribute("settle_sum"));
-    for (const char* k : {"threads", "settle_samples", "next_snapshot"}) w.attribute(k, cp.int_attribute(k));
-    for (const auto& n : cp.names()) {
-      if (n == "fluid/ln_J") {
-        std::vector<double> J = cp.doubles(n);
-        for (double& x : J) x = std::exp(x);
-        w.array("fluid/J", J);
-      } else if (n == "granular/regime") {
-        w.array(n, cp.bytes(n), cp.shape(n));
-      } else {
-        w.array(n, cp.doubles(n), cp.shape(n));
-      }
-    }
-    w.commit();
+    ASSERT_TRUE(io::read_checkpoint(path).has("fluid/ln_J"));
+    rewrite_as_older(path, [](const std::string& n, std::vector<double>& values) {  // J for ln J
+      if (n != "fluid/ln_J") return n;
+      for (double& x : values) x = std::exp(x);
+      return std::string("fluid/J");
+    });
   });
   ASSERT_EQ(b.step(), 300);
   ASSERT_TRUE(b.has("fluid/ln_J"));
@@ -166,6 +181,41 @@ TEST(RunScenes, RestartReadsAnOlderCheckpointWithJ) {
     EXPECT_LE(diff, 1e-9 * scale) << n;
   }
   EXPECT_NE(a.doubles("fluid/ln_J"), b.doubles("fluid/ln_J"));  // (the logarithm's round-off: not the same file)
+}
+
+TEST(RunScenes, RestartReadsAnOlderCheckpointWithTheSnapshotsX0) {
+  // Checkpoints before the grains' reference positions (the snapshots' displacements) lived in
+  // their body stored them as "analysis/x0_grains": such a file restarts bit for bit, and the
+  // snapshot after the restart (t = 9 ms; the restart is at step 150, 4.2 ms) shows the same
+  // displacements as the uninterrupted run's.
+  clitest::TempDir d;
+  std::string x0;
+  const auto [a, b] = restarted_settling(d,
+                                         [&](const std::string& path) {
+                                           rewrite_as_older(path, [&](const std::string& n, std::vector<double>&) {
+                                             if (!n.ends_with("/x0")) return n;
+                                             x0 = n;
+                                             return std::string("analysis/x0_grains");
+                                           });
+                                         },
+                                         {"analysis.snapshot_times=[0.002, 0.009]"});
+  ASSERT_FALSE(x0.empty());  // the grains' body holds its x0 when snapshots are taken
+  ASSERT_EQ(a.names(), b.names());
+  for (const auto& n : a.names()) {
+    if (n != "granular/regime") {
+      EXPECT_EQ(a.doubles(n), b.doubles(n)) << n;
+    }
+  }
+  const auto read = [](const std::filesystem::path& p) {
+    std::ifstream in(p);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string full = read(d / "full/snapshot_1.csv"), part = read(d / "part/snapshot_1.csv");
+  EXPECT_GT(full.size(), 1000u);
+  EXPECT_EQ(full, part);
+  // The grains settle: their displacement is not zero in the snapshot.
+  const auto disp = io::read_csv(d / "full/snapshot_1.csv").column("displacement_y");
+  EXPECT_LT(*std::min_element(disp.begin(), disp.end()), -1e-6);
 }
 
 TEST(RunScenes, InvalidScenesAreRefusedBeforeAnyOutput) {

@@ -90,6 +90,11 @@ struct Body {
   // Mixture fields interpolated from the nodes in G2P (fluid phase of a mixture only):
   std::vector<double> phi;        ///< granular volume fraction 1 − n at the point
   std::vector<double> div_q_1_s;  ///< div of the mixture volume flux q (E27)
+  /// Reference positions (the snapshots' grain displacements since t = 0, run/snapshots.cpp):
+  /// kept only while `keeps_x0` (set on every rank alike), empty otherwise. A per-point array
+  /// like the others: it is checkpointed and travels with its point between ranks.
+  bool keeps_x0 = false;
+  std::vector<Vec<D>> x0_m;
   std::unique_ptr<StressLaw<G>> law;
 
   std::int64_t size() const { return static_cast<std::int64_t>(mass_kg.size()); }
@@ -112,6 +117,9 @@ struct Body {
     list.add("f_ext", f_ext_N, "N");
     list.add("phi", phi, "1");
     list.add("div_q", div_q_1_s, "1/s");
+    // (checkpoints before the reference positions lived in the body read them from the snapshots'
+    // "analysis/x0_grains")
+    if (keeps_x0) list.add("x0", x0_m, "m", FrameForm::none, {}, "/analysis/x0_grains", [](double x) { return x; });
     list.frame_order({"x", "v", "stress", "pressure", "mass", "volume"});
   }
 
@@ -128,6 +136,7 @@ struct Body {
     f_ext_N.push_back(Vec<NC>::Zero());
     phi.push_back(0.0);
     div_q_1_s.push_back(0.0);
+    if (keeps_x0) x0_m.push_back(x);
     if (law) law->resize(size());
   }
 
@@ -145,6 +154,7 @@ struct Body {
     f_ext_N.resize(s, Vec<NC>::Zero());
     phi.resize(s, 0.0);
     div_q_1_s.resize(s, 0.0);
+    if (keeps_x0) x0_m.resize(s, Vec<D>::Zero());
     if (law) law->resize(n);
   }
 

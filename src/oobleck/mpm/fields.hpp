@@ -61,8 +61,9 @@ struct PersistentField {
   int frame_rank = 1 << 20;  ///< frames show fields by rank, then in declaration order
   /// Frame-only field: fill one value per item (called when a frame is written).
   std::function<void(std::span<double>)> derive;
-  /// Older checkpoints that stored this field as `legacy_name` (read when `name` is absent),
-  /// converted value by value with `from_legacy`.
+  /// Older checkpoints that stored this field as `legacy_name` (read when `name` is absent;
+  /// in the field's group, or "/GROUP/NAME" in another), converted value by value with
+  /// `from_legacy`.
   std::string legacy_name;
   double (*from_legacy)(double) = nullptr;
 

@@ -59,10 +59,12 @@ class AnnularAnalysis final : public SceneAnalysis<G> {
 };
 
 /// Mass-weighted mixture v_theta on the physical nodes (r fastest), and f of the grains.
+/// Decomposed runs: each node from its owner, f over every rank's points; on every rank.
 template <class G>
 void AnnularAnalysis<G>::sample_frame() {
   auto& solver = this->solver();
-  const auto& grid = solver.grid();
+  const auto& local = solver.grid();
+  const auto& grid = solver.global_grid();
   analysis::ShearFrame fr;
   fr.time_s = solver.time_s();
   fr.v_theta.origin_x = grid.origin_m[0];
@@ -70,25 +72,24 @@ void AnnularAnalysis<G>::sample_frame() {
   fr.v_theta.h = grid.h_m;
   fr.v_theta.nx = static_cast<std::size_t>(grid.cells[0]) + 1;
   fr.v_theta.ny = static_cast<std::size_t>(grid.periodic[1] ? grid.cells[1] : grid.cells[1] + 1);
-  fr.v_theta.values.assign(fr.v_theta.nx * fr.v_theta.ny, 0.0);
-  for (std::size_t j = 0; j < fr.v_theta.ny; ++j) {
-    for (std::size_t i = 0; i < fr.v_theta.nx; ++i) {
-      const int flat = grid.storage_index(0, static_cast<int>(i)) * grid.stride(0) +
-                       grid.storage_index(1, static_cast<int>(j)) * grid.stride(1);
-      double m = 0.0, mv = 0.0;
-      for (int b : {scene_.grains, scene_.fluid}) {
-        if (b < 0) continue;
-        const auto& fld = solver.field(b);
-        m += fld.mass_kg[flat];
-        mv += fld.mass_kg[flat] * fld.velocity[flat][2];
-      }
-      fr.v_theta.values[j * fr.v_theta.nx + i] = m > 0 ? mv / m : 0.0;
+  std::vector<double> v_theta(static_cast<std::size_t>(local.node_count()), 0.0);  // on the local storage
+  for (std::size_t flat = 0; flat < v_theta.size(); ++flat) {
+    double m = 0.0, mv = 0.0;
+    for (int b : {scene_.grains, scene_.fluid}) {
+      if (b < 0) continue;
+      const auto& fld = solver.field(b);
+      m += fld.mass_kg[flat];
+      mv += fld.mass_kg[flat] * fld.velocity[flat][2];
     }
+    v_theta[flat] = m > 0 ? mv / m : 0.0;
   }
+  fr.v_theta.values = physical_nodes_on_every_rank(solver, v_theta);
   if (scene_.grains >= 0 && scene_.granular_law) {  // the structure, for the structure front
     const auto* law = scene_.granular_law;
-    fr.f = nodal_average<G>(grid, {&solver.body(scene_.grains)},
-                            [&](std::size_t, std::int64_t p) { return law->f[static_cast<std::size_t>(p)]; });
+    fr.f = nodal_average<G>(
+        grid, {&solver.body(scene_.grains)},
+        [&](std::size_t, std::int64_t p) { return law->f[static_cast<std::size_t>(p)]; },
+        solver.decomposition() != nullptr);
   }
   frames_.push_back(std::move(fr));
 }

@@ -63,7 +63,9 @@ void restore_fields(const io::Checkpoint& cp, const mpm::FieldList& list) {
         [&](const auto& d) {
           using T = std::decay_t<decltype(d)>;
           if constexpr (std::is_same_v<T, std::span<double>>) {
-            const std::string legacy = f.group + "/" + f.legacy_name;
+            // (a legacy name starting with '/' names a dataset of another group)
+            const std::string legacy =
+                f.legacy_name.starts_with('/') ? f.legacy_name.substr(1) : f.group + "/" + f.legacy_name;
             if (!f.legacy_name.empty() && !cp.has(name) && cp.has(legacy)) {
               cp.read_into(legacy, d);
               for (double& x : d) x = f.from_legacy(x);

@@ -3,11 +3,12 @@
 // persistent fields that its parts declare (mpm/fields.hpp), written and restored by one loop.
 // The parts, in declaration order:
 //   solver_fields       per body b "body<b>/x", "v", "stress", "mass", "volume", "volume0", "C",
-//                       "L", "f_ext", "phi", "div_q" (Body::declare_fields); the granular law's
+//                       "L", "f_ext", "phi", "div_q" and, with snapshots, the grains' "x0"
+//                       (Body::declare_fields); the granular law's
 //                       "granular/f", "granular/regime", "granular/gamma_dot_p"; the fluid law's
 //                       "fluid/ln_J"; per [[body]] entry k "third<k>/rigid_velocity" and
 //                       "third<k>/impulse_sum"
-//   Snapshots           "analysis/x0_grains", attribute "next_snapshot" (run/snapshots.hpp)
+//   Snapshots           attribute "next_snapshot" (run/snapshots.hpp)
 //   SceneAnalysis       its samples under "analysis/" and attributes (run/analysis.hpp)
 #include "oobleck/io/checkpoint.hpp"
 #include "oobleck/mpm/fields.hpp"

@@ -4,8 +4,10 @@
 // in decomposed runs), and the mass-weighted nodal average of a point quantity (a post-processing
 // interpolation, independent of the solver's kernel).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "oobleck/analysis/data.hpp"
@@ -13,6 +15,7 @@
 #include "oobleck/mpm/body.hpp"
 #include "oobleck/mpm/contact.hpp"
 #include "oobleck/mpm/grid.hpp"
+#include "oobleck/mpm/halo.hpp"
 #include "oobleck/mpm/solver.hpp"
 
 namespace oobleck::run {
@@ -81,10 +84,11 @@ BodyTotals<G> body_totals(mpm::Solver<G>& solver, int b) {
 /// Mass-weighted nodal average of a point quantity over one or more bodies on the physical
 /// nodes of a 2D grid, with bilinear (tent) weights: value_i = Σ w_ip m_p q_p / Σ w_ip m_p
 /// (0 where no point contributes). Independent of the solver's kernel: a plain post-processing
-/// interpolation. `value(b, p)` gives q of point p of body b.
+/// interpolation. `value(b, p)` gives q of point p of body b. Decomposed runs: `grid` is the
+/// global grid and `across_ranks` sums both sums over the ranks first (every rank gets the field).
 template <class G, class F>
-analysis::GridField2D nodal_average(const mpm::Grid<2>& grid, const std::vector<const mpm::Body<G>*>& bodies,
-                                    F&& value) {
+analysis::GridField2D nodal_average(const mpm::Grid<2>& grid, const std::vector<const mpm::Body<G>*>& bodies, F&& value,
+                                    bool across_ranks = false) {
   analysis::GridField2D out;
   out.origin_x = grid.origin_m[0];
   out.origin_y = grid.origin_m[1];
@@ -116,7 +120,44 @@ analysis::GridField2D nodal_average(const mpm::Grid<2>& grid, const std::vector<
       }
     }
   }
+  if (across_ranks) {
+    std::vector<double> sums = out.values;
+    sums.insert(sums.end(), mass.begin(), mass.end());
+    comm::sum(sums);
+    std::copy_n(sums.begin(), out.values.size(), out.values.begin());
+    std::copy(sums.begin() + static_cast<long>(out.values.size()), sums.end(), mass.begin());
+  }
   for (std::size_t k = 0; k < mass.size(); ++k) out.values[k] = mass[k] > 0.0 ? out.values[k] / mass[k] : 0.0;
+  return out;
+}
+
+/// A nodal array of the solver's grid (its storage, e.g. the nodal porosity) on the global grid's
+/// physical nodes, x fastest, on every rank (decomposed runs: each node from its owner).
+template <class G>
+std::vector<double> physical_nodes_on_every_rank(const mpm::Solver<G>& solver, std::span<const double> stored) {
+  constexpr int D = G::dim;
+  const mpm::Grid<D>& grid = solver.global_grid();
+  std::size_t n = 1;
+  for (int a = 0; a < D; ++a) n *= static_cast<std::size_t>(grid.periodic[a] ? grid.cells[a] : grid.cells[a] + 1);
+  std::vector<double> out;
+  if (const auto* dec = solver.decomposition()) {
+    out = mpm::gather_physical_nodes<D>(*dec, solver.grid(), stored);
+    out.resize(n, 0.0);
+    comm::sum(out);  // (rank 0's values plus the others' zeros: exact)
+    return out;
+  }
+  out.resize(n);
+  std::size_t k = 0;
+  std::array<int, 3> nodes{1, 1, 1};
+  for (int a = 0; a < D; ++a) nodes[a] = grid.periodic[a] ? grid.cells[a] : grid.cells[a] + 1;
+  for (int kk = 0; kk < nodes[2]; ++kk)
+    for (int j = 0; j < nodes[1]; ++j)
+      for (int i = 0; i < nodes[0]; ++i) {
+        const int l[3] = {i, j, kk};
+        int flat = 0;
+        for (int a = 0; a < D; ++a) flat += grid.storage_index(a, l[a]) * grid.stride(a);
+        out[k++] = stored[static_cast<std::size_t>(flat)];
+      }
   return out;
 }
 

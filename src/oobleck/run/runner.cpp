@@ -106,8 +106,8 @@ class SceneRun {
   std::optional<io::RunFolderLock> lock_;  ///< held from before the first write to the end
 };
 
-/// What a decomposed run (several MPI ranks, docs/mpi.md) supports yet; InputError before any
-/// output otherwise. Also: --ranks-grid on one rank.
+/// A --ranks-grid that does not fit the ranks (docs/mpi.md) or the grid: InputError before any
+/// output.
 template <class G>
 void SceneRun<G>::check_decomposable() const {
   const int ranks = comm::size();
@@ -122,15 +122,6 @@ void SceneRun<G>::check_decomposable() const {
     }
     return;
   }
-  const auto kind = cfg_.analysis.kind;
-  if (kind == scene::AnalysisKind::Annular)
-    throw InputError(
-        fmt::format("{}: [analysis] kind = \"{}\" does not run decomposed yet (mpirun -np {}); run it on "
-                    "one rank (threads: --threads)",
-                    cfg_.file, scene::to_string(kind), ranks));
-  if (!cfg_.analysis.snapshot_times_s.empty())
-    throw InputError(
-        fmt::format("{}: analysis.snapshot_times: snapshots are not written by decomposed runs yet", cfg_.file));
   (void)layout();  // a --ranks-grid that does not fit the ranks or the grid: refused before any output
 }
 

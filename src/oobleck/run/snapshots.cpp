@@ -13,7 +13,13 @@ namespace oobleck::run {
 template <class G>
 Snapshots<G>::Snapshots(const scene::SceneConfig& config, const scene::BuiltScene<G>& scene, std::string out_dir)
     : cfg_(config), scene_(scene), out_dir_(std::move(out_dir)) {
-  if (scene.grains >= 0) x0_grains_ = scene.solver->body(scene.grains).x_m;
+  // The grains' reference positions live in their body (a per-point array that migrates with the
+  // points of a decomposed run), and only where snapshots are taken (2D grids).
+  if (scene.grains >= 0 && G::dim == 2 && !config.analysis.snapshot_times_s.empty()) {
+    mpm::Body<G>& grains = scene.solver->body(scene.grains);
+    grains.keeps_x0 = true;
+    grains.x0_m = grains.x_m;
+  }
 }
 
 template <class G>
@@ -30,7 +36,8 @@ bool Snapshots<G>::due(bool final_step) const {
 }
 
 /// Nodal fields (bilinear, mass-weighted): mixture velocity, grain displacement since t = 0,
-/// structure f, granular pressure p~ (zero without grains).
+/// structure f, granular pressure p~ (zero without grains). Decomposed runs: over every rank's
+/// points, on every rank.
 template <class G>
 SnapshotFields Snapshots<G>::fields() const {
   SnapshotFields s;
@@ -40,9 +47,11 @@ SnapshotFields Snapshots<G>::fields() const {
     std::vector<const mpm::Body<G>*> mix;
     for (int b : {scene_.grains, scene_.fluid})
       if (b >= 0) mix.push_back(&solver.body(b));
-    const auto& grid = solver.grid();
+    const auto& grid = solver.global_grid();
+    const bool across = solver.decomposition() != nullptr;
     auto vel = [&](int c) {
-      return nodal_average<G>(grid, mix, [&](std::size_t b, std::int64_t p) { return mix[b]->v_m_s[p][c]; });
+      return nodal_average<G>(
+          grid, mix, [&](std::size_t b, std::int64_t p) { return mix[b]->v_m_s[p][c]; }, across);
     };
     s.u_x = vel(0);
     s.u_y = vel(1);
@@ -51,16 +60,19 @@ SnapshotFields Snapshots<G>::fields() const {
       const auto* law = scene_.granular_law;
       const std::vector<const mpm::Body<G>*> gs = {&gb};
       auto displacement = [&](int a) {
-        return nodal_average<G>(grid, gs, [&](std::size_t, std::int64_t p) {
-          return mpm::periodic_difference<2>(grid, gb.x_m[p], x0_grains_[static_cast<std::size_t>(p)])[a];
-        });
+        return nodal_average<G>(
+            grid, gs,
+            [&](std::size_t, std::int64_t p) {
+              return mpm::periodic_difference<2>(grid, gb.x_m[p], gb.x0_m[static_cast<std::size_t>(p)])[a];
+            },
+            across);
       };
       s.displacement_x = displacement(0);
       s.displacement_y = displacement(1);
-      s.f =
-          nodal_average<G>(grid, gs, [&](std::size_t, std::int64_t p) { return law->f[static_cast<std::size_t>(p)]; });
-      s.p_grains =
-          nodal_average<G>(grid, gs, [&](std::size_t, std::int64_t p) { return -gb.stress_Pa[p].trace() / 3.0; });
+      s.f = nodal_average<G>(
+          grid, gs, [&](std::size_t, std::int64_t p) { return law->f[static_cast<std::size_t>(p)]; }, across);
+      s.p_grains = nodal_average<G>(
+          grid, gs, [&](std::size_t, std::int64_t p) { return -gb.stress_Pa[p].trace() / 3.0; }, across);
     } else {
       s.displacement_x = s.u_x;
       std::fill(s.displacement_x.values.begin(), s.displacement_x.values.end(), 0.0);
@@ -75,19 +87,19 @@ SnapshotFields Snapshots<G>::write_next() {
   SnapshotFields s = fields();
   if constexpr (G::dim == 2) {
     auto& solver = *scene_.solver;
-    const auto& grid = solver.grid();
     // phi = 1 - the step's nodal porosity (0 without a mixture).
-    const auto& n_nodal = solver.nodal_porosity();
+    const auto& stored = solver.nodal_porosity();
+    const std::vector<double> n_nodal =
+        stored.empty() ? std::vector<double>{} : physical_nodes_on_every_rank(solver, stored);
+    if (!comm::is_root()) {  // (decomposed: rank 0 writes the file)
+      ++next_;
+      return s;
+    }
     std::string text = "x,y,u_x,u_y,displacement_x,displacement_y,f,p_grains,phi\n";
     for (std::size_t j = 0; j < s.u_x.ny; ++j) {
       for (std::size_t i = 0; i < s.u_x.nx; ++i) {
         const std::size_t k = j * s.u_x.nx + i;
-        double phi = 0.0;
-        if (!n_nodal.empty()) {
-          const int flat = grid.storage_index(0, static_cast<int>(i)) * grid.stride(0) +
-                           grid.storage_index(1, static_cast<int>(j)) * grid.stride(1);
-          phi = 1.0 - n_nodal[static_cast<std::size_t>(flat)];
-        }
+        const double phi = n_nodal.empty() ? 0.0 : 1.0 - n_nodal[k];
         text += fmt::format("{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", s.u_x.x(i), s.u_x.y(j),
                             s.u_x.values[k], s.u_y.values[k], s.displacement_x.values[k], s.displacement_y.values[k],
                             s.f.values[k], s.p_grains.values[k], phi);
@@ -114,7 +126,6 @@ std::vector<std::string> Snapshots<G>::files() const {
 template <class G>
 void Snapshots<G>::declare_fields(mpm::FieldList& list) {
   list.group("analysis");
-  if (!x0_grains_.empty()) list.add("x0_grains", x0_grains_, "m");
   list.add_attribute("next_snapshot", next_, "1");
 }
 

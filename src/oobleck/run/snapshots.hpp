@@ -1,8 +1,9 @@
 #pragma once
 // Nodal-field snapshots at analysis.snapshot_times (docs/output.md "Snapshots"; 2D grids):
 // snapshot_<k>.csv with the mixture velocity, the grains' displacement since t = 0, f, p~ and phi
-// on the physical nodes. The grains' initial positions and the snapshot counter are checkpointed
-// ("analysis/x0_grains", attribute "next_snapshot").
+// on the physical nodes. The grains' initial positions are their body's reference positions
+// (Body::x0_m, checkpointed with the body); the snapshot counter is the attribute "next_snapshot".
+// Decomposed runs: the fields cover every rank's points; rank 0 writes the files.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -30,8 +31,7 @@ class Snapshots {
   /// The files written so far (for summary.json "snapshots").
   std::vector<std::string> files() const;
 
-  /// The initial grain positions "analysis/x0_grains" and the attribute "next_snapshot"
-  /// (mpm/fields.hpp).
+  /// The attribute "next_snapshot" (mpm/fields.hpp).
   void declare_fields(mpm::FieldList& list);
 
  private:
@@ -41,8 +41,7 @@ class Snapshots {
   const scene::SceneConfig& cfg_;
   const scene::BuiltScene<G>& scene_;
   std::string out_dir_;
-  std::vector<mpm::Vec<G::dim>> x0_grains_;  ///< initial grain positions (displacements)
-  std::int64_t next_ = 0;                    ///< index of the next snapshot time
+  std::int64_t next_ = 0;  ///< index of the next snapshot time
 };
 
 extern template class Snapshots<mpm::PlaneStrain>;
