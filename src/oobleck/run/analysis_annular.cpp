@@ -39,7 +39,7 @@ class AnnularAnalysis final : public SceneAnalysis<G> {
   /// "analysis/shear" (v_theta) and "analysis/shear_f" (f, when sampled) of the frames.
   void declare_state(mpm::FieldList& list) override {
     if constexpr (D == 2) {
-      const auto shape = node_field_shape(this->solver().grid());
+      const auto shape = node_field_shape(this->solver().global_grid());
       declare_field_frames(list, "shear", frames_, shape, "m/s",
                            [](analysis::ShearFrame& f) -> analysis::GridField2D& { return f.v_theta; });
       declare_field_frames(

@@ -32,7 +32,7 @@ class RodAnalysis final : public SceneAnalysis<G> {
     if (!profile_.is_null()) return;  // the first snapshot only
     // Fig. 7c: |dz| vs depth on the axis below the rod's tip.
     const double tip = body_tip(cfg_, scene_);
-    const auto& grid = this->solver().grid();
+    const auto& grid = this->solver().global_grid();
     try {
       const auto prof = analysis::displacement_below_rod(s.displacement_y, tip, scene::bed_surface(cfg_), -1.0,
                                                          grid.origin_m[0], grid.origin_m[1] + cfg_.grid.cell_size_m);
