@@ -37,6 +37,27 @@ def save(fig, path):
 
 # --- run-folder helpers (plot_intrusion.py, plot_rod.py, plot_wheel.py) -------------------------
 
+def frame_nearest(run, t=None, tool="oobleck_plot"):
+    """Path of the run's frame file (frames/frame_*.h5) whose time is nearest t seconds; the last
+    frame when t is None. SystemExit naming `tool` when the run wrote no frames."""
+    import glob
+    import os
+
+    import h5py
+    import numpy as np
+
+    paths = sorted(glob.glob(os.path.join(run, "frames", "frame_*.h5")))
+    if not paths:
+        raise SystemExit(f"{tool}: {run}/frames holds no frame_*.h5 (run with output.frame_interval > 0)")
+    if t is None:
+        return paths[-1]
+    times = []
+    for p in paths:
+        with h5py.File(p, "r") as h:
+            times.append(float(h.attrs["time"]))
+    return paths[int(np.argmin(np.abs(np.array(times) - t)))]
+
+
 def need_file(path, what):
     """SystemExit naming the path and what it should have held, unless path is a readable file."""
     import os

@@ -8,29 +8,16 @@ usage: plot_rod_3d.py OUT.png RUN_DIR [RUN_DIR ...] [--time T]
   faster than a tenth of the rod's speed (the plug driven by the rod), coloured by -v_z, and the
   rod. Reads frames/frame_*.h5 (h5py), the run's summary.json and scene.toml.
 """
-import glob
 import os
 import sys
 
 import h5py
 import numpy as np
-from oobleck_plot import load_scene, load_summary, plt, run_title, save, scene_body
+from oobleck_plot import frame_nearest, load_scene, load_summary, plt, run_title, save, scene_body
 
 
 def usage():
     raise SystemExit(__doc__.strip())
-
-
-def nearest_frame(run, t):
-    best, best_dt = None, np.inf
-    for path in sorted(glob.glob(os.path.join(run, "frames", "frame_*.h5"))):
-        with h5py.File(path, "r") as h:
-            dt = abs(float(h.attrs["time"]) - t)
-        if dt < best_dt:
-            best, best_dt = path, dt
-    if best is None:
-        raise SystemExit(f"plot_rod_3d: {run}/frames holds no frame_*.h5 (run with output.frame_interval > 0)")
-    return best
 
 
 def read_body(h, name):
@@ -54,7 +41,7 @@ def main(argv):
         rod = scene_body(scene, "rod")
         h_cell = scene["grid"]["cell_size"]
         half = 0.5 * h_cell / scene["region"][0].get("points_per_cell", 2)
-        path = nearest_frame(run, t)
+        path = frame_nearest(run, t, "plot_rod_3d")
         with h5py.File(path, "r") as h:
             time = float(h.attrs["time"])
             xg, vg = read_body(h, "grains")

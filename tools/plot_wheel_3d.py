@@ -10,30 +10,16 @@ usage: plot_wheel_3d.py OUT.png RUN_3D PLANE_RUN [RUN_3D PLANE_RUN ...] [--time 
   view are at the frame nearest T seconds (default: the last frame). Reads the runs' summary.json,
   scene.toml and frames/frame_*.h5 (h5py).
 """
-import glob
 import os
 import sys
 
 import h5py
 import numpy as np
-from oobleck_plot import load_scene, load_summary, plt, run_title, save, scene_body
+from oobleck_plot import frame_nearest, load_scene, load_summary, plt, run_title, save, scene_body
 
 
 def usage():
     raise SystemExit(__doc__.strip())
-
-
-def frame_near(run, t):
-    paths = sorted(glob.glob(os.path.join(run, "frames", "frame_*.h5")))
-    if not paths:
-        raise SystemExit(f"plot_wheel_3d: {run}/frames holds no frame_*.h5 (run with output.frame_interval > 0)")
-    if t is None:
-        return paths[-1]
-    times = []
-    for p in paths:
-        with h5py.File(p, "r") as h:
-            times.append(float(h.attrs["time"]))
-    return paths[int(np.argmin(np.abs(np.array(times) - t)))]
 
 
 def hub_series(s, run):
@@ -76,7 +62,7 @@ def main(argv):
         ax.set_title(f"ω = {s3.get('omega', '?')} rad/s: hub height", fontsize=9)
         ax.legend(fontsize=8)
 
-        path = frame_near(run3, t)
+        path = frame_nearest(run3, t, "plot_wheel_3d")
         with h5py.File(path, "r") as h:
             time = float(h.attrs["time"])
             xg, vg = h["bodies"]["grains"]["position"][()], h["bodies"]["grains"]["velocity"][()]
