@@ -9,6 +9,7 @@
 #include <limits>
 
 #include <gtest/gtest.h>
+#include <hdf5.h>
 
 #include "io_test_util.hpp"
 #include "oobleck/core/error.hpp"
@@ -202,6 +203,91 @@ TEST(Checkpoint, CorruptDataFailsChecksum) {
   std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
   const std::string msg = message_of([&] { (void)read_checkpoint(path); });
   EXPECT_NE(msg.find("'/arrays/grains/x' fails its checksum"), std::string::npos) << msg;
+}
+
+namespace {
+/// FNV-1a 64 (the published algorithm: offset basis 14695981039346656037, prime 1099511628211).
+std::int64_t fnv1a_64(const void* data, std::size_t bytes) {
+  std::uint64_t h = 14695981039346656037ULL;
+  for (std::size_t i = 0; i < bytes; ++i) {
+    h ^= static_cast<const unsigned char*>(data)[i];
+    h *= 1099511628211ULL;
+  }
+  return std::bit_cast<std::int64_t>(h);
+}
+
+/// Replace array `name`'s whole-array checksum with per-block ones (what the ranks of a
+/// decomposed run write): `values` per block, and their checksums.
+void use_block_checksums(const std::string& path, const std::string& name, const std::vector<std::int64_t>& values,
+                         const std::vector<std::int64_t>& checksums) {
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  const hid_t dset = H5Dopen2(file, ("arrays/" + name).c_str(), H5P_DEFAULT);
+  H5Adelete(dset, "checksum");
+  for (const auto& [attr, v] : {std::pair{"block_values", &values}, std::pair{"block_checksums", &checksums}}) {
+    const hsize_t n = v->size();
+    const hid_t space = H5Screate_simple(1, &n, nullptr);
+    const hid_t a = H5Acreate2(dset, attr, H5T_NATIVE_INT64, space, H5P_DEFAULT, H5P_DEFAULT);
+    H5Awrite(a, H5T_NATIVE_INT64, v->data());
+    H5Aclose(a);
+    H5Sclose(space);
+  }
+  H5Dclose(dset);
+  H5Fclose(file);
+}
+}  // namespace
+
+// The whole-array checksum is FNV-1a 64 of the raw bytes; a checkpoint whose checksums were
+// made with the offset basis 1469598103934665603 (older oobleck versions) still reads.
+TEST(Checkpoint, ChecksumIsFnv1a64AndTheOlderBasisReads) {
+  TempDir dir;
+  std::vector<double> marker(64);
+  for (std::size_t i = 0; i < marker.size(); ++i) marker[i] = 1234.5678 + static_cast<double>(i);
+  const std::string path = write_small(dir);
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  const hid_t dset = H5Dopen2(file, "arrays/grains/x", H5P_DEFAULT);
+  const hid_t attr = H5Aopen(dset, "checksum", H5P_DEFAULT);
+  std::int64_t stored = 0;
+  H5Aread(attr, H5T_NATIVE_INT64, &stored);
+  EXPECT_EQ(stored, fnv1a_64(marker.data(), marker.size() * sizeof(double)));
+  std::uint64_t older = 1469598103934665603ULL;
+  for (std::size_t i = 0; i < marker.size() * sizeof(double); ++i) {
+    older ^= reinterpret_cast<const unsigned char*>(marker.data())[i];
+    older *= 1099511628211ULL;
+  }
+  H5Awrite(attr, H5T_NATIVE_INT64, &older);
+  H5Aclose(attr);
+  H5Dclose(dset);
+  H5Fclose(file);
+  EXPECT_TRUE(same_bits(read_checkpoint(path).doubles("grains/x"), marker));
+}
+
+// An array that the ranks wrote together is checked block by block: the right checksums read
+// back, one wrong block fails, and blocks that do not add up to the array are refused.
+TEST(Checkpoint, BlockChecksumsAreCheckedBlockByBlock) {
+  TempDir dir;
+  std::vector<double> marker(64);
+  for (std::size_t i = 0; i < marker.size(); ++i) marker[i] = 1234.5678 + static_cast<double>(i);
+  const auto sum = [&](std::size_t from, std::size_t n) { return fnv1a_64(marker.data() + from, n * sizeof(double)); };
+
+  const std::string good = write_small(dir, "good.h5");
+  use_block_checksums(good, "grains/x", {20, 0, 44}, {sum(0, 20), sum(20, 0), sum(20, 44)});
+  const Checkpoint cp = read_checkpoint(good);
+  EXPECT_TRUE(same_bits(cp.doubles("grains/x"), marker));
+
+  const std::string wrong = write_small(dir, "wrong.h5");
+  use_block_checksums(wrong, "grains/x", {20, 44}, {sum(0, 20), sum(21, 43)});
+  std::string msg = message_of([&] { (void)read_checkpoint(wrong); });
+  EXPECT_NE(msg.find("'/arrays/grains/x' fails its checksum"), std::string::npos) << msg;
+
+  const std::string short_blocks = write_small(dir, "short.h5");
+  use_block_checksums(short_blocks, "grains/x", {20, 40}, {sum(0, 20), sum(20, 40)});
+  msg = message_of([&] { (void)read_checkpoint(short_blocks); });
+  EXPECT_NE(msg.find("'/arrays/grains/x' has blocks that do not match its size"), std::string::npos) << msg;
+
+  const std::string unpaired = write_small(dir, "unpaired.h5");
+  use_block_checksums(unpaired, "grains/x", {64}, {});
+  msg = message_of([&] { (void)read_checkpoint(unpaired); });
+  EXPECT_NE(msg.find("block checksums that do not match its blocks"), std::string::npos) << msg;
 }
 
 TEST(Checkpoint, MissingDatasetIsInputError) {

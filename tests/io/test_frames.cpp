@@ -1,5 +1,6 @@
 // HDF5 frames + XDMF index: exact round trip through the HDF5 C API, index consistency,
 // resume after restart, input checks.
+#include <array>
 #include <cstdlib>
 #include <filesystem>
 #include <regex>
@@ -186,6 +187,54 @@ TEST(Frames, Grid3DNodeOrderingIsXFastest) {
   // Origin and spacing in XDMF order z y x.
   EXPECT_NE(xmf.find(">0.29999999999999999 0.20000000000000001 0.10000000000000001<"), std::string::npos);
   EXPECT_NE(xmf.find(R"(GeometryType="XYZ")"), std::string::npos);
+}
+
+// A rank's part of the grid (NodeGrid::set_part) lands in its box of the whole grid's dataset:
+// node (i, j, k) of the part at (begin + (i, j, k)), scalars and vectors alike.
+TEST(Frames, GridPartLandsInItsBox) {
+  TempDir dir;
+  const std::size_t nx = 4, ny = 3, nz = 2;
+  const std::array<std::size_t, 3> begin{1, 1, 0}, extent{2, 2, 2};
+  const std::size_t n = extent[0] * extent[1] * extent[2];
+  std::vector<double> id(n), vx(n), vy(n), vz(n);
+  for (std::size_t k = 0; k < extent[2]; ++k)
+    for (std::size_t j = 0; j < extent[1]; ++j)
+      for (std::size_t i = 0; i < extent[0]; ++i) {
+        const std::size_t a = i + extent[0] * (j + extent[1] * k);
+        const std::size_t gi = begin[0] + i, gj = begin[1] + j, gk = begin[2] + k;
+        id[a] = static_cast<double>(100 * gk + 10 * gj + gi);
+        vx[a] = static_cast<double>(gi);
+        vy[a] = static_cast<double>(gj);
+        vz[a] = static_cast<double>(gk);
+      }
+  NodeGrid grid(3, {0, 0, 0}, {0.1, 0.1, 0.1}, {nx, ny, nz});
+  grid.set_part(begin, extent);
+  EXPECT_EQ(grid.count(), n);
+  grid.scalar("id", id).vector("velocity", {vx, vy, vz});
+  FrameWriter writer(dir.str(), "run");
+  const std::string path = writer.write({0.0, 0, {}, grid});
+  const auto r = read_h5_doubles(path, "/grid/id");
+  const auto v = read_h5_doubles(path, "/grid/velocity");
+  ASSERT_EQ(r.shape, (std::vector<std::uint64_t>{nz, ny, nx}));
+  ASSERT_EQ(v.shape, (std::vector<std::uint64_t>{nz, ny, nx, 3}));
+  int inside = 0;
+  for (std::size_t k = 0; k < nz; ++k)
+    for (std::size_t j = 0; j < ny; ++j)
+      for (std::size_t i = 0; i < nx; ++i) {
+        const std::size_t a = (k * ny + j) * nx + i;
+        const bool in = i >= begin[0] && i < begin[0] + extent[0] && j >= begin[1] && j < begin[1] + extent[1];
+        inside += in ? 1 : 0;
+        // (outside the box: HDF5's fill value 0)
+        EXPECT_EQ(r.values[a], in ? static_cast<double>(100 * k + 10 * j + i) : 0.0) << i << " " << j << " " << k;
+        EXPECT_EQ(v.values[3 * a], in ? static_cast<double>(i) : 0.0);
+        EXPECT_EQ(v.values[3 * a + 1], in ? static_cast<double>(j) : 0.0);
+        EXPECT_EQ(v.values[3 * a + 2], in ? static_cast<double>(k) : 0.0);
+      }
+  EXPECT_EQ(inside, static_cast<int>(n));
+  NodeGrid other(3, {0, 0, 0}, {0.1, 0.1, 0.1}, {nx, ny, nz});
+  EXPECT_THROW(other.set_part({3, 0, 0}, {2, 1, 1}), std::invalid_argument);  // leaves the grid along x
+  other.scalar("id", std::vector<double>(nx * ny * nz, 1.0));
+  EXPECT_THROW(other.set_part(begin, extent), std::invalid_argument);  // after a field
 }
 
 TEST(Frames, IndexReferencesExistingDatasetsWithMatchingDimensions) {

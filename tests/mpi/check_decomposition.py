@@ -140,6 +140,7 @@ def compare(ref, run, label, settling_tol=1e-9, field_tol=1e-10, snapshots=0):
         rel = np.abs(pb - pa).max() / scale
         check(rel <= 1e-12, f"{label}: momentum of {body} within {rel:.1e} of M max|v| (<= 1e-12)")
     compare_snapshots(ref, run, label, field_tol, snapshots)
+    compare_frame_files(ref, run, label, field_tol)
     fa, fb = final_frame(ref), final_frame(run)
     for body in fa:
         xa, xb = fa[body]["position"], fb[body]["position"]
@@ -155,6 +156,46 @@ def compare(ref, run, label, settling_tol=1e-9, field_tol=1e-10, snapshots=0):
             rel = np.abs(B - A).max() / scale
             check(rel <= field_tol, f"{label}: {body} {k} after {a['steps']} steps: {rel:.1e} of its largest magnitude "
                                     f"(<= {field_tol:g})")
+
+
+def frame_layout(path):
+    """Every group and dataset of a frame file: name -> (shape, dtype, attributes but `xdmf`)."""
+    out = {}
+    with h5py.File(path, "r") as f:
+        def visit(name, obj):
+            attrs = {k: (v.tolist() if hasattr(v, "tolist") else v) for k, v in obj.attrs.items() if k != "xdmf"}
+            out[name] = (getattr(obj, "shape", None), str(getattr(obj, "dtype", "")), attrs)
+        out["/"] = (None, "", {k: v for k, v in f.attrs.items()})
+        f.visititems(visit)
+    return out
+
+
+def compare_frame_files(ref, run, label, field_tol):
+    """The frames that the ranks wrote together (parallel HDF5) read as the one-rank run's: the
+    same XDMF index, text for text; in every frame file the same groups, datasets (shape, type)
+    and attributes; each body's vertex list 0..N-1; the final frame's nodal fields within
+    field_tol of their largest magnitude."""
+    with open(os.path.join(ref, "frames.xmf")) as fa, open(os.path.join(run, "frames.xmf")) as fb:
+        check(fa.read() == fb.read(), f"{label}: frames.xmf is the one-rank run's, text for text")
+    files = sorted(os.path.basename(f) for f in glob.glob(os.path.join(ref, "frames", "frame_*.h5")))
+    other = sorted(os.path.basename(f) for f in glob.glob(os.path.join(run, "frames", "frame_*.h5")))
+    check(files == other and len(files) > 0, f"{label}: frame files {len(other)} = {len(files)}")
+    same = all(frame_layout(os.path.join(ref, "frames", n)) == frame_layout(os.path.join(run, "frames", n))
+               for n in files if n in other)
+    check(same, f"{label}: every frame file holds the one-rank run's groups, datasets and attributes")
+    if not files or files != other:
+        return
+    with h5py.File(os.path.join(ref, "frames", files[-1]), "r") as fa, \
+            h5py.File(os.path.join(run, "frames", files[-1]), "r") as fb:
+        for body in fb["bodies"]:
+            conn = np.array(fb["bodies"][body]["connectivity"])
+            check(np.array_equal(conn, np.arange(len(conn))), f"{label}: {body}: vertex list 0..{len(conn) - 1}")
+        if "grid" in fa:
+            for k in fa["grid"]:
+                A, B = np.array(fa["grid"][k]), np.array(fb["grid"][k])
+                rel = np.abs(B - A).max() / max(np.abs(A).max(), 1e-300)
+                check(rel <= field_tol, f"{label}: grid {k} {A.shape}: {rel:.1e} of its largest magnitude "
+                                        f"(<= {field_tol:g})")
 
 
 def compare_snapshots(ref, run, label, field_tol, expected):
@@ -391,6 +432,24 @@ def case_restart(work):
     half = run_ok(os.path.join(work, "r_half"), SETTLING_3D, 2, 1, ["--stop-after", "100"])
     check(summary(half)["complete"] is False and os.path.exists(os.path.join(half, "checkpoint.h5")),
           "restart: the 2-rank run stopped after 100 steps with a checkpoint")
+    # Written by both ranks together: each point array with a checksum per rank's block.
+    with h5py.File(os.path.join(half, "checkpoint.h5"), "r") as f:
+        x = f["arrays/body0/x"]
+        blocks = x.attrs.get("block_values")
+        check(blocks is not None and len(blocks) == 2 and int(sum(blocks)) == x.shape[0] and min(blocks) > 0,
+              f"restart: body0/x written by 2 ranks (blocks {None if blocks is None else blocks.tolist()} "
+              f"of {x.shape[0]} values)")
+    # A changed value in rank 1's block fails that block's checksum.
+    bad = os.path.join(work, "r_damaged")
+    shutil.rmtree(bad, ignore_errors=True)
+    shutil.copytree(half, bad)
+    with h5py.File(os.path.join(bad, "checkpoint.h5"), "r+") as f:
+        x = f["arrays/body0/x"]
+        x[x.shape[0] - 1] = x[x.shape[0] - 1] + 1e-9
+    rc, err = oobleck(["--restart", bad], 1)
+    said = [l for l in err.splitlines() if "checksum" in l]
+    check(rc != 0 and any("body0/x' fails its checksum" in l for l in said),
+          f"restart: a damaged block is refused (status {rc}: {said[0].strip() if said else err[-300:]})")
     for ranks in (1, 3):
         d = os.path.join(work, f"r_on{ranks}")
         shutil.rmtree(d, ignore_errors=True)

@@ -204,6 +204,19 @@ std::vector<double> gather_to_root(std::span<const double> values) {
   return {values.begin(), values.end()};
 }
 
+std::vector<std::int64_t> all_gather(std::span<const std::int64_t> values) {
+#ifdef OOBLECK_HAVE_MPI
+  if (active()) {
+    Timed t;
+    std::vector<std::int64_t> all(values.size() * static_cast<std::size_t>(size()));
+    MPI_Allgather(values.data(), static_cast<int>(values.size()), MPI_INT64_T, all.data(),
+                  static_cast<int>(values.size()), MPI_INT64_T, MPI_COMM_WORLD);
+    return all;
+  }
+#endif
+  return {values.begin(), values.end()};
+}
+
 void sendrecv(std::span<const double> send, int to, std::span<double> recv, int from, [[maybe_unused]] int tag) {
 #ifdef OOBLECK_HAVE_MPI
   if (active()) {

@@ -1,7 +1,8 @@
 #pragma once
-// The MPI layer (docs/mpi.md): the one place that calls MPI. Every other file talks to the
-// ranks through these functions, which are plain serial code in a build without MPI and in a
-// process that was not started by mpirun (a one-rank world).
+// The MPI layer (docs/mpi.md): the one place that calls MPI (parallel HDF5 also opens its
+// files on MPI_COMM_WORLD, io/detail/h5.cpp). Every other file talks to the ranks through these
+// functions, which are plain serial code in a build without MPI and in a process that was not
+// started by mpirun (a one-rank world).
 //
 //   comm::init(argc, argv);          // main(): starts MPI only under mpirun (Open MPI's environment)
 //   if (comm::size() > 1) ...        // a decomposed run
@@ -53,6 +54,9 @@ bool any(bool flag);
 std::string broadcast(const std::string& from_root);
 /// Every rank's values, concatenated in rank order, on rank 0 (empty elsewhere).
 std::vector<double> gather_to_root(std::span<const double> values);
+/// Every rank's values (the same count on each), concatenated in rank order, on every rank
+/// (MPI_Allgather).
+std::vector<std::int64_t> all_gather(std::span<const std::int64_t> values);
 
 /// MPI_Sendrecv of doubles: `send` to rank `to`, `recv` (its size is the expected count) from rank
 /// `from`; -1 for either means no partner on that side.

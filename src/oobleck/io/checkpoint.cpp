@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <set>
 #include <stdexcept>
 
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include "oobleck/core/comm.hpp"
 #include "oobleck/core/error.hpp"
 #include "oobleck/io/detail/h5.hpp"
 #include "oobleck/io/output_file.hpp"
@@ -20,9 +22,14 @@ namespace {
 
 constexpr const char* kFormat = "oobleck-checkpoint-1";
 
-std::uint64_t fnv1a(const void* data, std::size_t bytes) {
+constexpr std::uint64_t kFnvOffsetBasis = 14695981039346656037ULL;  // FNV-1a 64
+/// The offset basis of the whole-array checksums of older checkpoints (a digit short of FNV's),
+/// still accepted on reading.
+constexpr std::uint64_t kOlderOffsetBasis = 1469598103934665603ULL;
+
+std::uint64_t fnv1a(const void* data, std::size_t bytes, std::uint64_t basis = kFnvOffsetBasis) {
   const auto* p = static_cast<const unsigned char*>(data);
-  std::uint64_t h = 1469598103934665603ULL;
+  std::uint64_t h = basis;
   for (std::size_t i = 0; i < bytes; ++i) {
     h ^= p[i];
     h *= 1099511628211ULL;
@@ -63,23 +70,43 @@ struct CheckpointWriter::Impl {
   std::set<std::string> names;
   std::string name_list;
   bool committed = false;
+  bool every_rank = false;  // (Writers::every_rank in a decomposed run)
+  bool root = true;         // this process renames the file (rank 0)
+  /// Every rank: rank 0's attributes and arrays, written by it alone on commit() (its arguments:
+  /// the file and the /arrays group).
+  std::vector<std::function<void(hid_t, hid_t)>> later;
+
+  /// Write to the file now, or (every rank) on rank 0 at commit().
+  void put(std::function<void(hid_t, hid_t)> write) {
+    if (!every_rank) {
+      write(file.get(), arrays.get());
+    } else if (root) {
+      later.push_back(std::move(write));
+    }
+  }
 };
 
-CheckpointWriter::CheckpointWriter(std::string path) : path_(std::move(path)), impl_(std::make_unique<Impl>()) {
+CheckpointWriter::CheckpointWriter(std::string path, Writers writers)
+    : path_(std::move(path)), impl_(std::make_unique<Impl>()) {
   check_writable(path_, "checkpoint");
+  impl_->every_rank = writers == Writers::every_rank && comm::size() > 1;
+  impl_->root = !impl_->every_rank || comm::is_root();
   impl_->tmp = fmt::format("{}.tmp-{}", path_, ::getpid());
+  if (impl_->every_rank) impl_->tmp = comm::broadcast(impl_->tmp);  // (rank 0's name)
   try {
-    impl_->file = h5::create_file(impl_->tmp, true);
+    impl_->file = h5::create_file(impl_->tmp, true, impl_->every_rank);
   } catch (const std::exception& e) {
     throw InputError(fmt::format("checkpoint '{}': {}", path_, e.what()));
   }
-  h5::write_attribute(impl_->file.get(), "format", std::string(kFormat));
-  h5::write_attribute(impl_->file.get(), "step", std::int64_t{0});
-  h5::write_attribute(impl_->file.get(), "time", 0.0);
-  h5::write_attribute(impl_->file.get(), "config", std::string());
   impl_->arrays = h5::create_group(impl_->file.get(), "arrays");
   impl_->lcpl = h5::Handle(H5Pcreate(H5P_LINK_CREATE));
   H5Pset_create_intermediate_group(impl_->lcpl.get(), 1);
+  impl_->put([](hid_t file, hid_t) {
+    h5::write_attribute(file, "format", std::string(kFormat));
+    h5::write_attribute(file, "step", std::int64_t{0});
+    h5::write_attribute(file, "time", 0.0);
+    h5::write_attribute(file, "config", std::string());
+  });
 }
 
 CheckpointWriter::~CheckpointWriter() {
@@ -88,33 +115,44 @@ CheckpointWriter::~CheckpointWriter() {
     impl_->lcpl.reset();
     impl_->file.reset();
     std::error_code ec;
-    fs::remove(impl_->tmp, ec);
+    if (impl_->root) fs::remove(impl_->tmp, ec);
   }
 }
 
-void CheckpointWriter::set_step(std::int64_t step) { h5::write_attribute(impl_->file.get(), "step", step); }
-void CheckpointWriter::set_time(double time) { h5::write_attribute(impl_->file.get(), "time", time); }
+void CheckpointWriter::set_step(std::int64_t step) {
+  impl_->put([step](hid_t file, hid_t) { h5::write_attribute(file, "step", step); });
+}
+void CheckpointWriter::set_time(double time) {
+  impl_->put([time](hid_t file, hid_t) { h5::write_attribute(file, "time", time); });
+}
 void CheckpointWriter::set_config(const std::string& resolved_configuration) {
-  h5::write_attribute(impl_->file.get(), "config", resolved_configuration);
-}
-
-void CheckpointWriter::attribute(const std::string& name, double value) {
-  check_attribute_name(name);
-  h5::write_attribute(impl_->file.get(), "real_" + name, value);
-}
-void CheckpointWriter::attribute(const std::string& name, std::int64_t value) {
-  check_attribute_name(name);
-  h5::write_attribute(impl_->file.get(), "int_" + name, value);
-}
-void CheckpointWriter::attribute(const std::string& name, const std::string& value) {
-  check_attribute_name(name);
-  h5::write_attribute(impl_->file.get(), "text_" + name, value);
+  impl_->put(
+      [resolved_configuration](hid_t file, hid_t) { h5::write_attribute(file, "config", resolved_configuration); });
 }
 
 namespace {
 template <class T>
-void write_array(CheckpointWriter::Impl& impl, const std::string& path, const std::string& name, hid_t type,
-                 std::span<const T> data, std::vector<std::uint64_t> shape) {
+void put_attribute(CheckpointWriter::Impl& impl, const std::string& name, const T& value) {
+  check_attribute_name(name);
+  impl.put([name, value](hid_t file, hid_t) { h5::write_attribute(file, name, value); });
+}
+}  // namespace
+
+void CheckpointWriter::attribute(const std::string& name, double value) {
+  put_attribute(*impl_, "real_" + name, value);
+}
+void CheckpointWriter::attribute(const std::string& name, std::int64_t value) {
+  put_attribute(*impl_, "int_" + name, value);
+}
+void CheckpointWriter::attribute(const std::string& name, const std::string& value) {
+  put_attribute(*impl_, "text_" + name, value);
+}
+
+namespace {
+/// Check a new array's name (plain, unused) and that `shape` (empty: one dimension) holds its
+/// `values`; returns the shape and adds the name to the list.
+std::vector<std::uint64_t> new_array(CheckpointWriter::Impl& impl, const std::string& path, const std::string& name,
+                                     std::size_t values, std::vector<std::uint64_t> shape) {
   if (impl.committed) throw std::logic_error(fmt::format("checkpoint '{}': array '{}' after commit()", path, name));
   if (!plain_name(name, true)) {
     throw std::invalid_argument(
@@ -123,24 +161,68 @@ void write_array(CheckpointWriter::Impl& impl, const std::string& path, const st
   if (impl.names.count(name) > 0) {
     throw std::invalid_argument(fmt::format("checkpoint '{}': array '{}' written twice", path, name));
   }
-  if (shape.empty()) shape = {data.size()};
+  if (shape.empty()) shape = {values};
   std::uint64_t count = 1;
   for (auto n : shape) count *= n;
-  if (count != data.size()) {
+  if (count != values) {
     throw std::invalid_argument(
-        fmt::format("checkpoint array '{}': shape holds {} values but {} were given", name, count, data.size()));
+        fmt::format("checkpoint array '{}': shape holds {} values but {} were given", name, count, values));
   }
   impl.names.insert(name);
-  std::vector<hsize_t> dims(shape.begin(), shape.end());
-  h5::Handle space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr));
-  h5::Handle dset(
-      H5Dcreate2(impl.arrays.get(), name.c_str(), type, space.get(), impl.lcpl.get(), H5P_DEFAULT, H5P_DEFAULT));
-  if (!dset.valid() || (count > 0 && H5Dwrite(dset.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0)) {
-    throw std::runtime_error(
-        fmt::format("checkpoint '{}': cannot write array '{}' ({})", path, name, h5::last_error()));
-  }
-  h5::write_attribute(dset.get(), "checksum", as_int64(fnv1a(data.data(), data.size_bytes())));
   impl.name_list += name + "\n";
+  return shape;
+}
+
+template <class T>
+void write_array(CheckpointWriter::Impl& impl, const std::string& path, const std::string& name, hid_t type,
+                 std::span<const T> data, std::vector<std::uint64_t> shape) {
+  shape = new_array(impl, path, name, data.size(), std::move(shape));
+  auto write = [&impl, path, name, type, shape](hid_t, hid_t arrays, std::span<const T> values) {
+    try {
+      h5::write_dataset_part(arrays, name, type, shape, std::vector<std::uint64_t>(shape.size(), 0), shape,
+                             values.data(), impl.lcpl.get());
+    } catch (const std::exception& e) {
+      throw std::runtime_error(fmt::format("checkpoint '{}': {}", path, e.what()));
+    }
+    h5::Handle dset(H5Dopen2(arrays, name.c_str(), H5P_DEFAULT));
+    h5::write_attribute(dset.get(), "checksum", as_int64(fnv1a(values.data(), values.size_bytes())));
+  };
+  if (!impl.every_rank) {
+    write(impl.file.get(), impl.arrays.get(), data);
+  } else if (impl.root) {  // (rank 0's values, kept until commit())
+    impl.put([write, copy = std::vector<T>(data.begin(), data.end())](hid_t file, hid_t arrays) {
+      write(file, arrays, copy);
+    });
+  }
+}
+
+template <class T>
+void write_ranks_array(CheckpointWriter::Impl& impl, const std::string& path, const std::string& name, hid_t type,
+                       std::span<const T> data) {
+  if (!impl.every_rank) return write_array(impl, path, name, type, data, {});
+  new_array(impl, path, name, data.size(), {data.size()});  // (this rank's block)
+  // Every rank's block: its values and checksum; this rank's block starts after the lower ranks'.
+  const std::int64_t mine[2] = {static_cast<std::int64_t>(data.size()),
+                                as_int64(fnv1a(data.data(), data.size_bytes()))};
+  const std::vector<std::int64_t> all = comm::all_gather(mine);
+  std::vector<std::int64_t> values, checksums;
+  std::uint64_t first = 0, total = 0;
+  for (int r = 0; r < comm::size(); ++r) {
+    const auto n = static_cast<std::uint64_t>(all[2 * static_cast<std::size_t>(r)]);
+    if (r < comm::rank()) first += n;
+    total += n;
+    values.push_back(all[2 * static_cast<std::size_t>(r)]);
+    checksums.push_back(all[2 * static_cast<std::size_t>(r) + 1]);
+  }
+  try {
+    h5::write_dataset_part(impl.arrays.get(), name, type, {total}, {first}, {data.size()}, data.data(),
+                           impl.lcpl.get());
+  } catch (const std::exception& e) {
+    throw std::runtime_error(fmt::format("checkpoint '{}': {}", path, e.what()));
+  }
+  h5::Handle dset(H5Dopen2(impl.arrays.get(), name.c_str(), H5P_DEFAULT));
+  h5::write_attribute(dset.get(), "block_values", values);
+  h5::write_attribute(dset.get(), "block_checksums", checksums);
 }
 }  // namespace
 
@@ -155,18 +237,43 @@ void CheckpointWriter::array(const std::string& name, std::span<const std::uint8
                              std::vector<std::uint64_t> shape) {
   write_array(*impl_, path_, name, H5T_NATIVE_UINT8, data, std::move(shape));
 }
+void CheckpointWriter::ranks_array(const std::string& name, std::span<const double> data) {
+  write_ranks_array(*impl_, path_, name, H5T_NATIVE_DOUBLE, data);
+}
+void CheckpointWriter::ranks_array(const std::string& name, std::span<const std::uint8_t> data) {
+  write_ranks_array(*impl_, path_, name, H5T_NATIVE_UINT8, data);
+}
 
 void CheckpointWriter::commit() {
   if (impl_->committed) return;
-  // The list of arrays, written last: a reader finds every listed dataset or reports which is
-  // missing, without walking the file.
-  h5::write_attribute(impl_->arrays.get(), "names", impl_->name_list);
-  impl_->arrays.reset();
-  impl_->lcpl.reset();
-  if (!impl_->file.reset()) {
-    throw std::runtime_error(fmt::format("checkpoint '{}': closing the file failed (disk full?)", path_));
+  auto close = [&] {
+    impl_->arrays.reset();
+    impl_->lcpl.reset();
+    return impl_->file.reset();
+  };
+  if (impl_->every_rank) {
+    // The ranks' arrays are in; rank 0 adds its attributes and arrays to the file alone.
+    if (comm::any(!close())) {
+      throw std::runtime_error(fmt::format("checkpoint '{}': closing the file failed (disk full?)", path_));
+    }
+    if (impl_->root) {
+      impl_->file = h5::open_file_readwrite(impl_->tmp, true);
+      impl_->arrays = h5::Handle(H5Gopen2(impl_->file.get(), "arrays", H5P_DEFAULT));
+      impl_->lcpl = h5::Handle(H5Pcreate(H5P_LINK_CREATE));
+      H5Pset_create_intermediate_group(impl_->lcpl.get(), 1);
+      for (const auto& write : impl_->later) write(impl_->file.get(), impl_->arrays.get());
+    }
   }
-  fs::rename(impl_->tmp, path_);
+  if (impl_->root) {
+    // The list of arrays, written last: a reader finds every listed dataset or reports which is
+    // missing, without walking the file.
+    h5::write_attribute(impl_->arrays.get(), "names", impl_->name_list);
+    if (!close()) {
+      throw std::runtime_error(fmt::format("checkpoint '{}': closing the file failed (disk full?)", path_));
+    }
+    fs::rename(impl_->tmp, path_);
+  }
+  if (impl_->every_rank) comm::barrier();
   impl_->committed = true;
 }
 
@@ -245,12 +352,42 @@ herr_t collect_attr(hid_t, const char* name, const H5A_info_t*, void* data) {
   return 0;
 }
 
+/// Whether array `a` (read from `dset`) matches its stored checksum: one over the array, or one
+/// per rank's block (an array the ranks wrote together). `fail(why)` makes the error for an
+/// array without a usable checksum.
+template <class Fail>
+bool checksums_match(hid_t dset, const Checkpoint::Array& a, Fail fail) {
+  std::int64_t stored = 0;
+  std::vector<std::int64_t> values, checksums;
+  const bool whole = h5::read_attribute(dset, "checksum", stored);
+  if (!whole &&
+      (!h5::read_attribute(dset, "block_values", values) || !h5::read_attribute(dset, "block_checksums", checksums)))
+    throw fail("has no checksum");
+  return std::visit(
+      [&](const auto& v) {
+        const std::size_t bytes = v.size() * sizeof(v[0]);
+        if (whole)
+          return stored == as_int64(fnv1a(v.data(), bytes)) ||
+                 stored == as_int64(fnv1a(v.data(), bytes, kOlderOffsetBasis));
+        if (values.size() != checksums.size()) throw fail("has block checksums that do not match its blocks");
+        std::size_t at = 0;
+        for (std::size_t k = 0; k < values.size(); ++k) {
+          const auto n = static_cast<std::size_t>(values[k]);
+          if (values[k] < 0 || n > v.size() - at) throw fail("has blocks that do not match its size");
+          if (as_int64(fnv1a(v.data() + at, n * sizeof(v[0]))) != checksums[k]) return false;
+          at += n;
+        }
+        if (at != v.size()) throw fail("has blocks that do not match its size");
+        return true;
+      },
+      a.data);
+}
+
 template <class T>
 Checkpoint::Array read_typed(hid_t dset, hid_t mem_type, std::vector<std::uint64_t> shape, std::uint64_t count,
-                             bool& ok, std::uint64_t& checksum) {
+                             bool& ok) {
   std::vector<T> v(count);
   ok = count == 0 || H5Dread(dset, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) >= 0;
-  checksum = fnv1a(v.data(), v.size() * sizeof(T));
   return {std::move(shape), std::move(v)};
 }
 }  // namespace
@@ -324,23 +461,20 @@ Checkpoint read_checkpoint(const std::string& path) {
     const H5T_class_t cls = H5Tget_class(type.get());
     const std::size_t size = H5Tget_size(type.get());
     bool ok = false;
-    std::uint64_t sum = 0;
     Checkpoint::Array a;
     if (cls == H5T_FLOAT && size == 8) {
-      a = read_typed<double>(dset.get(), H5T_NATIVE_DOUBLE, shape, count, ok, sum);
+      a = read_typed<double>(dset.get(), H5T_NATIVE_DOUBLE, shape, count, ok);
     } else if (cls == H5T_INTEGER && size == 8 && H5Tget_sign(type.get()) == H5T_SGN_2) {
-      a = read_typed<std::int64_t>(dset.get(), H5T_NATIVE_INT64, shape, count, ok, sum);
+      a = read_typed<std::int64_t>(dset.get(), H5T_NATIVE_INT64, shape, count, ok);
     } else if (cls == H5T_INTEGER && size == 1 && H5Tget_sign(type.get()) == H5T_SGN_NONE) {
-      a = read_typed<std::uint8_t>(dset.get(), H5T_NATIVE_UINT8, shape, count, ok, sum);
+      a = read_typed<std::uint8_t>(dset.get(), H5T_NATIVE_UINT8, shape, count, ok);
     } else {
       throw fail(fmt::format("dataset '/arrays/{}' has a type other than double, int64, uint8", name));
     }
     if (!ok) throw fail(fmt::format("dataset '/arrays/{}' cannot be read (truncated or corrupt?)", name));
-    std::int64_t stored = 0;
-    if (!h5::read_attribute(dset.get(), "checksum", stored)) {
-      throw fail(fmt::format("dataset '/arrays/{}' has no checksum", name));
-    }
-    if (stored != as_int64(sum))
+    if (!checksums_match(dset.get(), a, [&](const std::string& why) {
+          return fail(fmt::format("dataset '/arrays/{}' {}", name, why));
+        }))
       throw fail(fmt::format("dataset '/arrays/{}' fails its checksum (corrupt data)", name));
     cp.arrays_.emplace(name, std::move(a));
   }

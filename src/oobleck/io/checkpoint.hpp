@@ -6,12 +6,19 @@
 //   /            attributes: format "oobleck-checkpoint-1", step, time, config, and the extra
 //                attributes (real_*, int_*, text_* prefixes keep their kinds apart)
 //   /arrays/NAME dataset of the array's type and shape; attribute `checksum` (FNV-1a 64 of the
-//                raw bytes, as int64) detects damaged data that HDF5 itself would not notice
+//                raw bytes, as int64) detects damaged data that HDF5 itself would not notice. An
+//                array that the ranks of a decomposed run wrote together has instead
+//                `block_checksums` (FNV-1a 64 of each rank's block, in rank order) and
+//                `block_values` (the values in each block)
 //
 // Names may contain '/' to group arrays ("grains/velocity"). Values are written in the native
 // representation and read back without conversion: the round trip is bit-exact (NaN payloads
 // and signed zeros included). Writing goes to a temporary file renamed over the target on
 // commit(), so a crash never leaves a half-written checkpoint under the final name.
+//
+// Decomposed runs (Writers::every_rank): every rank makes the writer and the same calls; the
+// per-point arrays (ranks_array) are written together with parallel HDF5, each rank its own
+// points; attributes and the other arrays are rank 0's, which it adds alone on commit().
 #include <cstddef>
 #include <cstdint>
 #include <map>
@@ -21,13 +28,16 @@
 #include <variant>
 #include <vector>
 
+#include "oobleck/io/writers.hpp"
+
 namespace oobleck::io {
 
 /// Streams arrays into a new checkpoint file without copying them.
 class CheckpointWriter {
  public:
   /// Opens `path` + ".tmp-PID" for writing; InputError when the folder is missing or read-only.
-  explicit CheckpointWriter(std::string path);
+  /// Writers::every_rank: made on every rank of a decomposed run (collective).
+  explicit CheckpointWriter(std::string path, Writers writers = Writers::one);
   CheckpointWriter(const CheckpointWriter&) = delete;
   CheckpointWriter& operator=(const CheckpointWriter&) = delete;
   ~CheckpointWriter();  // removes the temporary file unless committed
@@ -46,8 +56,14 @@ class CheckpointWriter {
   void array(const std::string& name, std::span<const std::int64_t> data, std::vector<std::uint64_t> shape = {});
   void array(const std::string& name, std::span<const std::uint8_t> data, std::vector<std::uint64_t> shape = {});
 
+  /// Store under `name` every rank's `data` concatenated in rank order (one dimension): the
+  /// points of a decomposed run, written by every rank at once. One writer: array(name, data).
+  void ranks_array(const std::string& name, std::span<const double> data);
+  void ranks_array(const std::string& name, std::span<const std::uint8_t> data);
+
   /// Close and atomically rename to the target path. Throws std::runtime_error when the file
   /// cannot be completed (disk full); the previous checkpoint at `path`, if any, is then kept.
+  /// Every rank: returns once rank 0 has renamed the file.
   void commit();
   const std::string& path() const { return path_; }
 

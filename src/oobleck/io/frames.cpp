@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include "oobleck/core/comm.hpp"
 #include "oobleck/core/error.hpp"
 #include "oobleck/io/detail/h5.hpp"
 #include "oobleck/io/output_file.hpp"
@@ -84,12 +85,28 @@ std::string hdf_item(const std::vector<std::uint64_t>& shape, const std::string&
                      dims_text(shape), ref);
 }
 
-/// Write one field under `loc` with leading shape `lead` (N) or (nz, ny, nx); append its XDMF
+/// Where this process's items lie in a dataset's leading axes: (N) for points, (nz, ny, nx) for
+/// the grid's nodes; `start` and `count` are this process's block of `shape` (all of it when it
+/// writes alone).
+struct Block {
+  std::vector<std::uint64_t> shape, start, count;
+  Block with_components(int out) const {
+    Block b = *this;
+    if (out > 1) {
+      b.shape.push_back(static_cast<std::uint64_t>(out));
+      b.start.push_back(0);
+      b.count.push_back(static_cast<std::uint64_t>(out));
+    }
+    return b;
+  }
+};
+
+/// Write one field under `loc` (this process's `count` items of `block`); append its XDMF
 /// <Attribute> to `xml`.
-void write_field(hid_t loc, const std::string& h5_prefix, const FieldView& f, std::size_t count,
-                 std::vector<std::uint64_t> shape, std::string& xml, const std::string& indent) {
+void write_field(hid_t loc, const std::string& h5_prefix, const FieldView& f, std::size_t count, const Block& block,
+                 std::string& xml, const std::string& indent) {
   const int out = stored_components(f.type);
-  if (out > 1) shape.push_back(static_cast<std::uint64_t>(out));
+  const Block full = block.with_components(out);
   const bool direct = f.parts.size() == 1 && f.components == out;
   std::vector<double> buf;
   const double* data = f.parts.empty() ? nullptr : f.parts[0].data();
@@ -97,7 +114,8 @@ void write_field(hid_t loc, const std::string& h5_prefix, const FieldView& f, st
     buf = interleave(f.parts, count, f.components, out);
     data = buf.data();
   }
-  h5::write_dataset(loc, f.name, H5T_NATIVE_DOUBLE, shape, data);
+  const std::vector<std::uint64_t>& shape = full.shape;
+  h5::write_dataset_part(loc, f.name, H5T_NATIVE_DOUBLE, shape, full.start, full.count, data);
   {
     h5::Handle d(H5Dopen2(loc, f.name.c_str(), H5P_DEFAULT));
     h5::write_attribute(d.get(), "type", std::string(xdmf_type_name(f.type)));
@@ -225,7 +243,12 @@ PointCloud::PointCloud(std::string name, std::initializer_list<std::span<const d
 
 NodeGrid::NodeGrid(int dim, std::array<double, 3> origin, std::array<double, 3> spacing,
                    std::array<std::size_t, 3> nodes)
-    : FieldSet(nodes[0] * nodes[1] * nodes[2]), dim_(dim), origin_(origin), spacing_(spacing), nodes_(nodes) {
+    : FieldSet(nodes[0] * nodes[1] * nodes[2]),
+      dim_(dim),
+      origin_(origin),
+      spacing_(spacing),
+      nodes_(nodes),
+      part_extent_(nodes) {
   if (dim != 2 && dim != 3) throw std::invalid_argument(fmt::format("grid: dim {} is not 2 or 3", dim));
   if (dim == 2 && nodes[2] != 1) throw std::invalid_argument("grid: a 2D grid needs nodes[2] = 1");
   for (int a = 0; a < dim; ++a) {
@@ -237,15 +260,31 @@ NodeGrid::NodeGrid(int dim, std::array<double, 3> origin, std::array<double, 3> 
   }
 }
 
+void NodeGrid::set_part(std::array<std::size_t, 3> begin, std::array<std::size_t, 3> extent) {
+  if (!fields_.empty()) throw std::invalid_argument("grid: set_part after fields were added");
+  for (std::size_t a = 0; a < 3; ++a) {
+    if (begin[a] + extent[a] > nodes_[a])
+      throw std::invalid_argument(
+          fmt::format("grid: part {}+{} of axis {} leaves its {} nodes", begin[a], extent[a], a, nodes_[a]));
+  }
+  part_begin_ = begin;
+  part_extent_ = extent;
+  count_ = extent[0] * extent[1] * extent[2];
+}
+
 // ---------------------------------------------------------------------------------------------
 // FrameWriter
 
-FrameWriter::FrameWriter(std::string run_dir, std::string name)
-    : FrameWriter(std::move(run_dir), std::move(name), true) {}
+FrameWriter::FrameWriter(std::string run_dir, std::string name, Writers writers)
+    : FrameWriter(std::move(run_dir), std::move(name), true, writers) {}
 
-FrameWriter::FrameWriter(std::string run_dir, std::string name, bool fresh)
-    : run_dir_(std::move(run_dir)), name_(std::move(name)) {
+FrameWriter::FrameWriter(std::string run_dir, std::string name, bool fresh, Writers writers)
+    : run_dir_(std::move(run_dir)),
+      name_(std::move(name)),
+      every_rank_(writers == Writers::every_rank && comm::size() > 1),
+      indexer_(!every_rank_ || comm::is_root()) {
   check_name(name_, "frame series");
+  if (!indexer_) return;
   std::error_code ec;
   if (!fs::is_directory(run_dir_, ec)) {
     throw InputError(fmt::format("output folder '{}' does not exist (frames cannot be written)", run_dir_));
@@ -270,8 +309,12 @@ std::string FrameWriter::frame_path(std::size_t index) const {
   return (fs::path(frame_dir()) / fmt::format("{}{:06d}{}", kFramePrefix, index, kFrameSuffix)).string();
 }
 
-FrameWriter FrameWriter::resume(std::string run_dir, std::int64_t last_step, std::string name) {
-  FrameWriter w(std::move(run_dir), std::move(name), false);
+FrameWriter FrameWriter::resume(std::string run_dir, std::int64_t last_step, std::string name, Writers writers) {
+  FrameWriter w(std::move(run_dir), std::move(name), false, writers);
+  if (!w.indexer_) {  // (rank 0 reads the series; the others only count its frames)
+    w.entries_.resize(std::stoull(comm::broadcast({})));
+    return w;
+  }
   // Frame files are numbered consecutively from 0; stop at the first gap.
   std::size_t index = 0;
   for (;; ++index) {
@@ -304,34 +347,40 @@ FrameWriter FrameWriter::resume(std::string run_dir, std::int64_t last_step, std
     if (!fs::exists(path)) break;
     fs::remove(path, ec);
   }
+  if (w.every_rank_) comm::broadcast(std::to_string(w.entries_.size()));
   w.write_index();
   return w;
 }
 
 namespace {
 
-/// One body's group of a frame file (positions, vertex list, fields) and its XDMF grid block.
-std::string write_body_block(hid_t bodies, const PointCloud& b, const std::string& rel, const std::string& time_xml) {
+/// One body's group of a frame file (positions, vertex list, fields) and its XDMF grid block:
+/// this process's b.count() points are points [first, first + count) of the body's `n`.
+std::string write_body_block(hid_t bodies, const PointCloud& b, std::size_t first, std::size_t n,
+                             const std::string& rel, const std::string& time_xml) {
   h5::Handle g = h5::create_group(bodies, b.name());
-  const std::size_t n = b.count();
-  const std::vector<std::uint64_t> pshape{n, static_cast<std::uint64_t>(b.dim())};
+  const std::size_t mine = b.count();
+  const Block points{{n}, {first}, {mine}};
+  const Block xyz = points.with_components(b.dim());
   if (b.positions().size() == 1) {
-    h5::write_dataset(g.get(), "position", H5T_NATIVE_DOUBLE, pshape, b.positions()[0].data());
+    h5::write_dataset_part(g.get(), "position", H5T_NATIVE_DOUBLE, xyz.shape, xyz.start, xyz.count,
+                           b.positions()[0].data());
   } else {
-    const auto buf = interleave(b.positions(), n, b.dim(), b.dim());
-    h5::write_dataset(g.get(), "position", H5T_NATIVE_DOUBLE, pshape, buf.data());
+    const auto buf = interleave(b.positions(), mine, b.dim(), b.dim());
+    h5::write_dataset_part(g.get(), "position", H5T_NATIVE_DOUBLE, xyz.shape, xyz.start, xyz.count, buf.data());
   }
+  const std::vector<std::uint64_t>& pshape = xyz.shape;
   // Explicit vertex list 0..N-1: the Xdmf3 readers make no cells of a Polyvertex topology
   // without one (points then do not render); the XDMF (2) reader accepts it too.
   const bool small = n <= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
   if (small) {
-    std::vector<std::int32_t> conn(n);
-    for (std::size_t i = 0; i < n; ++i) conn[i] = static_cast<std::int32_t>(i);
-    h5::write_dataset(g.get(), "connectivity", H5T_NATIVE_INT32, {n}, conn.data());
+    std::vector<std::int32_t> conn(mine);
+    for (std::size_t i = 0; i < mine; ++i) conn[i] = static_cast<std::int32_t>(first + i);
+    h5::write_dataset_part(g.get(), "connectivity", H5T_NATIVE_INT32, {n}, {first}, {mine}, conn.data());
   } else {
-    std::vector<std::int64_t> conn(n);
-    for (std::size_t i = 0; i < n; ++i) conn[i] = static_cast<std::int64_t>(i);
-    h5::write_dataset(g.get(), "connectivity", H5T_NATIVE_INT64, {n}, conn.data());
+    std::vector<std::int64_t> conn(mine);
+    for (std::size_t i = 0; i < mine; ++i) conn[i] = static_cast<std::int64_t>(first + i);
+    h5::write_dataset_part(g.get(), "connectivity", H5T_NATIVE_INT64, {n}, {first}, {mine}, conn.data());
   }
   h5::write_attribute(g.get(), "count", static_cast<std::int64_t>(n));
   std::string xml;
@@ -347,7 +396,7 @@ std::string write_body_block(hid_t bodies, const PointCloud& b, const std::strin
   xml += fmt::format("      <Geometry GeometryType=\"{}\">\n", b.dim() == 2 ? "XY" : "XYZ");
   xml += fmt::format("        {}\n", hdf_item(pshape, prefix + "/position"));
   xml += "      </Geometry>\n";
-  for (const auto& f : b.fields()) write_field(g.get(), prefix, f, n, {n}, xml, "      ");
+  for (const auto& f : b.fields()) write_field(g.get(), prefix, f, mine, points, xml, "      ");
   xml += "    </Grid>\n";
   h5::write_attribute(g.get(), "xdmf", xml);
   return xml;
@@ -369,6 +418,9 @@ std::string write_grid_block(hid_t file, const NodeGrid& grid, const std::string
   // 2DCoRectMesh in the y-z plane, away from the XY points; a 3DCoRectMesh with nz = 1
   // lies in the x-y plane.
   const std::vector<std::uint64_t> lead{nn[2], nn[1], nn[0]};
+  const auto& at = grid.part_begin();
+  const auto& span = grid.part_extent();
+  const Block nodes{lead, {at[2], at[1], at[0]}, {span[2], span[1], span[0]}};
   std::string xml;
   xml += fmt::format("    <Grid Name=\"{}\" GridType=\"Uniform\">\n", kGridBlock);
   xml += time_xml;
@@ -383,7 +435,7 @@ std::string write_grid_block(hid_t file, const NodeGrid& grid, const std::string
       "Format=\"XML\">{:.17g} {:.17g} {:.17g}</DataItem>\n",
       h[2], h[1], h[0]);
   xml += "      </Geometry>\n";
-  for (const auto& f : grid.fields()) write_field(g.get(), rel + ":/grid", f, grid.count(), lead, xml, "      ");
+  for (const auto& f : grid.fields()) write_field(g.get(), rel + ":/grid", f, grid.count(), nodes, xml, "      ");
   xml += "    </Grid>\n";
   h5::write_attribute(g.get(), "xdmf", xml);
   return xml;
@@ -406,21 +458,40 @@ std::string FrameWriter::write(const Frame& frame) {
   }
   if (frame.grid) check_fields(*frame.grid, "grid");
 
+  // Each body's points on this process: [first, first + count) of its total (every rank: rank
+  // order).
+  std::vector<std::int64_t> mine;
+  for (const auto& b : frame.bodies) mine.push_back(static_cast<std::int64_t>(b.count()));
+  std::vector<std::size_t> first(mine.size(), 0), total(mine.begin(), mine.end());
+  if (every_rank_) {
+    const std::vector<std::int64_t> all = comm::all_gather(mine);
+    for (std::size_t b = 0; b < mine.size(); ++b) {
+      total[b] = 0;
+      for (int r = 0; r < comm::size(); ++r) {
+        const auto n = static_cast<std::size_t>(all[static_cast<std::size_t>(r) * mine.size() + b]);
+        if (r < comm::rank()) first[b] += n;
+        total[b] += n;
+      }
+    }
+  }
+
   const std::string time_xml = fmt::format("      <Time Value=\"{:.17g}\"/>\n", frame.time);
   Entry entry{frame.step, frame.time, {}};
   std::string block_list;
-  const std::string tmp = fmt::format("{}.tmp-{}", path, ::getpid());
+  std::string tmp = fmt::format("{}.tmp-{}", path, ::getpid());
+  if (every_rank_) tmp = comm::broadcast(tmp);  // (rank 0's name)
   try {
-    h5::Handle file = h5::create_file(tmp);
+    h5::Handle file = h5::create_file(tmp, false, every_rank_);
     h5::write_attribute(file.get(), "time", frame.time);
     h5::write_attribute(file.get(), "step", frame.step);
     h5::write_attribute(file.get(), "format", std::string("oobleck-frame-1"));
     h5::Handle bodies = h5::create_group(file.get(), "bodies");
-    for (const auto& b : frame.bodies) {
-      std::string xml = write_body_block(bodies.get(), b, rel, time_xml);
+    for (std::size_t k = 0; k < frame.bodies.size(); ++k) {
+      const PointCloud& b = frame.bodies[k];
+      std::string xml = write_body_block(bodies.get(), b, first[k], total[k], rel, time_xml);
       // ParaView rejects a Polyvertex grid of zero points: an empty body stays in the HDF5 file
       // (so its fields are still listed) but not in the index of this frame.
-      if (b.count() > 0) {
+      if (total[k] > 0) {
         entry.blocks.emplace_back(b.name(), std::move(xml));
         block_list += b.name() + "\n";
       }
@@ -433,10 +504,10 @@ std::string FrameWriter::write(const Frame& frame) {
     h5::write_attribute(file.get(), "blocks", block_list);
     bodies.reset();
     if (!file.reset()) throw std::runtime_error("closing the file failed (disk full?)");
-    fs::rename(tmp, path);
+    if (indexer_) fs::rename(tmp, path);
   } catch (const std::exception& e) {
     std::error_code ec;
-    fs::remove(tmp, ec);
+    if (indexer_) fs::remove(tmp, ec);
     throw std::runtime_error(fmt::format("cannot write frame file '{}': {}", path, e.what()));
   }
   entries_.push_back(std::move(entry));
@@ -449,6 +520,8 @@ std::string FrameWriter::write(const Frame& frame) {
 FrameWriter::FrameWriter(FrameWriter&& o) noexcept
     : run_dir_(std::move(o.run_dir_)),
       name_(std::move(o.name_)),
+      every_rank_(o.every_rank_),
+      indexer_(o.indexer_),
       entries_(std::move(o.entries_)),
       index_stale_(o.index_stale_),
       index_bytes_(o.index_bytes_),
@@ -465,6 +538,8 @@ FrameWriter& FrameWriter::operator=(FrameWriter&& o) noexcept {
     }
     run_dir_ = std::move(o.run_dir_);
     name_ = std::move(o.name_);
+    every_rank_ = o.every_rank_;
+    indexer_ = o.indexer_;
     entries_ = std::move(o.entries_);
     index_stale_ = o.index_stale_;
     index_bytes_ = o.index_bytes_;
@@ -488,6 +563,10 @@ void FrameWriter::flush() {
 }
 
 void FrameWriter::write_index() {
+  if (!indexer_) {
+    index_stale_ = false;
+    return;
+  }
   const auto start = std::chrono::steady_clock::now();
   // One temporal collection per block (body or grid), in order of first appearance: ParaView
   // then shows one block per body with the same name at every time.

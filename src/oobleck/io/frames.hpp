@@ -28,6 +28,10 @@
 //
 // The writer depends on nothing but spans of doubles, so it serves any solver layout:
 // interleaved arrays (x0 y0 x1 y1 ...) or structure of arrays (one span per component).
+//
+// In a decomposed run every rank writes the frame file together (Writers::every_rank, parallel
+// HDF5): each gives its own points and its own block of the grid's nodes; the file holds every
+// rank's points in rank order, as one dataset per field, and reads as a one-rank run's does.
 #include <array>
 #include <chrono>
 #include <cstddef>
@@ -38,6 +42,8 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "oobleck/io/writers.hpp"
 
 namespace oobleck::io {
 
@@ -123,10 +129,18 @@ class NodeGrid : public FieldSet {
   const std::array<double, 3>& spacing() const { return spacing_; }
   const std::array<std::size_t, 3>& nodes() const { return nodes_; }
 
+  /// The fields added after this call hold only the box of nodes that starts at node `begin`
+  /// and spans `extent` nodes per axis (x fastest): this rank's part of a grid that every rank
+  /// writes (Writers::every_rank). Without it they hold every node. std::invalid_argument when
+  /// fields were added already or the box leaves the grid.
+  void set_part(std::array<std::size_t, 3> begin, std::array<std::size_t, 3> extent);
+  const std::array<std::size_t, 3>& part_begin() const { return part_begin_; }
+  const std::array<std::size_t, 3>& part_extent() const { return part_extent_; }
+
  private:
   int dim_;
   std::array<double, 3> origin_, spacing_;
-  std::array<std::size_t, 3> nodes_;
+  std::array<std::size_t, 3> nodes_, part_begin_{0, 0, 0}, part_extent_;
 };
 
 struct Frame {
@@ -142,13 +156,16 @@ class FrameWriter {
   /// Start a new series `name` ("frames") in `run_dir`, which must exist (InputError
   /// otherwise). Frame files of an earlier series with the same name (RUN/NAME/frame_*.h5) and
   /// its index are removed, so a reused output folder never mixes two runs.
-  explicit FrameWriter(std::string run_dir, std::string name = "frames");
+  /// Writers::every_rank: made on every rank of a decomposed run, whose write() calls are then
+  /// collective (rank 0 alone checks and cleans the folder and writes the index).
+  explicit FrameWriter(std::string run_dir, std::string name = "frames", Writers writers = Writers::one);
 
   /// Continue a series after a restart from step `last_step`: frames with step <= last_step are
   /// kept (their index entries are rebuilt from the frame files), later ones are deleted.
   /// Unreadable frame files (a crash mid-write leaves none, but a damaged disk might) are an
   /// InputError naming the file.
-  static FrameWriter resume(std::string run_dir, std::int64_t last_step, std::string name = "frames");
+  static FrameWriter resume(std::string run_dir, std::int64_t last_step, std::string name = "frames",
+                            Writers writers = Writers::one);
 
   FrameWriter(FrameWriter&& other) noexcept;
   FrameWriter& operator=(FrameWriter&& other) noexcept;
@@ -157,7 +174,8 @@ class FrameWriter {
   /// Brings the index up to date (flush()), reporting nothing on failure.
   ~FrameWriter();
 
-  /// Write one frame file and rewrite the index. Returns the frame file's path. Failures while
+  /// Write one frame file and rewrite the index. Returns the frame file's path. Every rank: each
+  /// passes its own points (and part of the grid, NodeGrid::set_part), the same bodies and fields. Failures while
   /// writing (disk full) throw std::runtime_error naming the file; the index still lists every
   /// frame written before.
   ///
@@ -184,11 +202,13 @@ class FrameWriter {
     double time;
     std::vector<std::pair<std::string, std::string>> blocks;  // (body or "grid", its <Grid> element)
   };
-  FrameWriter(std::string run_dir, std::string name, bool fresh);
+  FrameWriter(std::string run_dir, std::string name, bool fresh, Writers writers);
   void write_index();
 
   std::string run_dir_, name_;
-  std::vector<Entry> entries_;
+  bool every_rank_ = false;     // (Writers::every_rank in a decomposed run)
+  bool indexer_ = true;         // this process handles the folder and the index (rank 0)
+  std::vector<Entry> entries_;  // (on the other ranks of every_rank_ only their number counts)
   bool index_stale_ = false;
   std::size_t index_bytes_ = 0;
   double index_seconds_ = 0.0;                           // duration of the last rewrite

@@ -66,6 +66,9 @@ struct PersistentField {
   /// `from_legacy`.
   std::string legacy_name;
   double (*from_legacy)(double) = nullptr;
+  /// One item per point of a body (FieldList::add): a decomposed run's ranks each hold their own
+  /// points' items, and write them to a checkpoint together (io::CheckpointWriter::ranks_array).
+  bool per_point = false;
 
   bool is_attribute() const {
     return std::holds_alternative<double*>(data) || std::holds_alternative<std::int64_t*>(data);
@@ -101,7 +104,7 @@ class FieldList {
   /// Following declarations belong to checkpoint group `g`.
   void group(std::string g) { group_ = std::move(g); }
 
-  /// A per-item array of doubles or Eigen vectors/matrices; width from the element type. Shown
+  /// A per-point array of doubles or Eigen vectors/matrices; width from the element type. Shown
   /// in the frames as `frame` (under `frame_name` if not empty); `legacy_name`, `from_legacy`:
   /// see PersistentField.
   template <class T>
@@ -119,17 +122,30 @@ class FieldList {
                  1 << 20,
                  {},
                  std::move(legacy_name),
-                 from_legacy});
+                 from_legacy,
+                 true});
   }
   PersistentField& add(std::string name, std::vector<std::uint8_t>& v, const char* unit,
                        FrameForm frame = FrameForm::none) {
-    return push(
-        {group_, std::move(name), 1, unit, std::span<std::uint8_t>(v), true, frame, {}, 1 << 20, {}, {}, nullptr});
+    return push({group_,
+                 std::move(name),
+                 1,
+                 unit,
+                 std::span<std::uint8_t>(v),
+                 true,
+                 frame,
+                 {},
+                 1 << 20,
+                 {},
+                 {},
+                 nullptr,
+                 true});
   }
   /// A fixed-size array of `width` doubles (one item; e.g. a rigid body's velocity).
   PersistentField& add_values(std::string name, std::span<double> values, const char* unit) {
     const int width = static_cast<int>(values.size());
-    return push({group_, std::move(name), width, unit, values, true, FrameForm::none, {}, 1 << 20, {}, {}, nullptr});
+    return push(
+        {group_, std::move(name), width, unit, values, true, FrameForm::none, {}, 1 << 20, {}, {}, nullptr, false});
   }
   /// A series that grows during the run (see GrowingSeries).
   PersistentField& add_series(std::string name, const char* unit, std::function<std::vector<double>()> pack,
@@ -145,24 +161,37 @@ class FieldList {
                  1 << 20,
                  {},
                  {},
-                 nullptr});
+                 nullptr,
+                 false});
   }
   /// One number, stored as a checkpoint attribute.
   PersistentField& add_attribute(std::string name, double& value, const char* unit) {
-    return push({group_, std::move(name), 1, unit, &value, true, FrameForm::none, {}, 1 << 20, {}, {}, nullptr});
+    return push({group_, std::move(name), 1, unit, &value, true, FrameForm::none, {}, 1 << 20, {}, {}, nullptr, false});
   }
   PersistentField& add_attribute(std::string name, std::int64_t& value, const char* unit) {
-    return push({group_, std::move(name), 1, unit, &value, true, FrameForm::none, {}, 1 << 20, {}, {}, nullptr});
+    return push({group_, std::move(name), 1, unit, &value, true, FrameForm::none, {}, 1 << 20, {}, {}, nullptr, false});
   }
   /// A nodal array (grid storage order) the frames show on the physical nodes (not in
   /// checkpoints: the step recomputes it).
   PersistentField& add_nodal(std::string name, std::span<double> nodes, const char* unit) {
-    return push({group_, std::move(name), 1, unit, nodes, false, FrameForm::node_scalar, {}, 1 << 20, {}, {}, nullptr});
+    return push(
+        {group_, std::move(name), 1, unit, nodes, false, FrameForm::node_scalar, {}, 1 << 20, {}, {}, nullptr, false});
   }
   /// A scalar the frames compute from other fields (not in checkpoints).
   PersistentField& derived(std::string name, const char* unit, std::function<void(std::span<double>)> fill) {
-    return push(
-        {group_, std::move(name), 1, unit, {}, false, FrameForm::scalar, {}, 1 << 20, std::move(fill), {}, nullptr});
+    return push({group_,
+                 std::move(name),
+                 1,
+                 unit,
+                 {},
+                 false,
+                 FrameForm::scalar,
+                 {},
+                 1 << 20,
+                 std::move(fill),
+                 {},
+                 nullptr,
+                 false});
   }
   /// Show an already declared field of the current group in the frames, as `form`, under
   /// `frame_name` if given (e.g. the fluid law shows its body's phi, and its pressure as

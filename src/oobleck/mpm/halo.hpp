@@ -235,6 +235,37 @@ std::int64_t gather_points_to_root(Body<G>& body) {
   return own;
 }
 
+/// The global grid's physical nodes that this rank owns: the box of `extent` nodes per axis
+/// from node `begin` (global logical indices; unused axes 0 and 1). Its first node is the local
+/// grid's logical node 0; a block at a non-periodic upper end owns the last node layer too.
+struct OwnedNodes {
+  std::array<int, 3> begin{0, 0, 0}, extent{1, 1, 1};
+};
+template <int D>
+OwnedNodes owned_physical_nodes(const Decomposition<D>& dec, const Grid<D>& local) {
+  OwnedNodes box;
+  for (int a = 0; a < D; ++a) {
+    const bool last = dec.coords()[a] == dec.dims()[a] - 1;
+    box.begin[a] = dec.block_begin(a);
+    box.extent[a] = local.cells[a] + (last && !dec.global().periodic[a] ? 1 : 0);
+  }
+  return box;
+}
+
+/// f(local flat index, local logical (i, j, k)) for each node of owned_physical_nodes, x fastest.
+template <int D, class F>
+void for_owned_physical_nodes(const Decomposition<D>& dec, const Grid<D>& local, F&& f) {
+  const OwnedNodes box = owned_physical_nodes(dec, local);
+  for (int k = 0; k < box.extent[2]; ++k)
+    for (int j = 0; j < box.extent[1]; ++j)
+      for (int i = 0; i < box.extent[0]; ++i) {
+        const std::array<int, 3> l{i, j, k};
+        int flat = 0;
+        for (int a = 0; a < D; ++a) flat += local.storage_index(a, l[a]) * local.stride(a);
+        f(static_cast<std::size_t>(flat), l);
+      }
+}
+
 /// A nodal array of the local grid on the global grid's physical nodes (x fastest), on rank 0
 /// (empty elsewhere): each node from its owner.
 template <int D>
@@ -243,28 +274,16 @@ std::vector<double> gather_physical_nodes(const Decomposition<D>& dec, const Gri
   const Grid<D>& g = dec.global();
   std::array<int, 3> nodes{1, 1, 1};
   for (int a = 0; a < D; ++a) nodes[a] = g.periodic[a] ? g.cells[a] : g.cells[a] + 1;
-  // The owned physical nodes of this block: local logical [0, n), and n at a non-periodic upper end.
-  std::array<int, 3> lo{0, 0, 0}, hi{1, 1, 1};
-  for (int a = 0; a < D; ++a) {
-    lo[a] = 0;
-    hi[a] = local.cells[a];
-    const bool last = dec.coords()[a] == dec.dims()[a] - 1;
-    if (last && !g.periodic[a]) hi[a] += 1;
-  }
   std::vector<double> packed;  // (global flat index, value) pairs
-  for (int k = lo[2]; k < hi[2]; ++k)
-    for (int j = lo[1]; j < hi[1]; ++j)
-      for (int i = lo[0]; i < hi[0]; ++i) {
-        const int l[3] = {i, j, k};
-        int flat = 0, global_flat = 0, scale = 1;
-        for (int a = 0; a < D; ++a) {
-          flat += local.storage_index(a, l[a]) * local.stride(a);
-          global_flat += (dec.block_begin(a) + l[a]) * scale;
-          scale *= nodes[a];
-        }
-        packed.push_back(global_flat);
-        packed.push_back(values[static_cast<std::size_t>(flat)]);
-      }
+  for_owned_physical_nodes(dec, local, [&](std::size_t flat, const std::array<int, 3>& l) {
+    int global_flat = 0, scale = 1;
+    for (int a = 0; a < D; ++a) {
+      global_flat += (dec.block_begin(a) + l[a]) * scale;
+      scale *= nodes[a];
+    }
+    packed.push_back(global_flat);
+    packed.push_back(values[flat]);
+  });
   const std::vector<double> all = comm::gather_to_root(packed);
   std::vector<double> out;
   if (!comm::is_root()) return out;

@@ -40,10 +40,13 @@ void save_fields(io::CheckpointWriter& cp, const mpm::FieldList& list) {
     std::visit(
         [&](const auto& d) {
           using T = std::decay_t<decltype(d)>;
-          if constexpr (std::is_same_v<T, std::span<double>>) {
-            cp.array(name, std::span<const double>(d));
-          } else if constexpr (std::is_same_v<T, std::span<std::uint8_t>>) {
-            cp.array(name, std::span<const std::uint8_t>(d));
+          if constexpr (std::is_same_v<T, std::span<double>> || std::is_same_v<T, std::span<std::uint8_t>>) {
+            using V = std::span<const typename T::value_type>;
+            if (f.per_point) {
+              cp.ranks_array(name, V(d));  // (decomposed: every rank's points)
+            } else {
+              cp.array(name, V(d));
+            }
           } else if constexpr (std::is_same_v<T, mpm::GrowingSeries>) {
             const std::vector<double> values = d.pack();
             if (!values.empty()) cp.array(name, values);

@@ -22,7 +22,9 @@ template <class G>
 mpm::FieldList solver_fields(const scene::BuiltScene<G>& scene);
 
 /// Write every field of `list` that belongs in a checkpoint: arrays as flat datasets, growing
-/// series when not empty, numbers as attributes.
+/// series when not empty, numbers as attributes. A decomposed run calls it on every rank with
+/// a writer of every rank: the points' arrays hold every rank's points (rank order), the others
+/// are rank 0's.
 void save_fields(io::CheckpointWriter& cp, const mpm::FieldList& list);
 
 /// Read them back in place: an array or attribute the checkpoint lacks, or an array of another

@@ -75,7 +75,7 @@ io::PointCloud body_cloud(const scene::BuiltScene<G>& scene, int b, Columns& col
 }
 
 /// The solver's nodal frame fields (Solver::declare_grid_fields) on the physical nodes (x
-/// fastest); nullopt when it declares none.
+/// fastest; decomposed: this rank's own box of them); nullopt when it declares none.
 template <class G>
 std::optional<io::NodeGrid> node_grid(const scene::BuiltScene<G>& scene, Columns& column) {
   constexpr int D = G::dim;
@@ -84,7 +84,8 @@ std::optional<io::NodeGrid> node_grid(const scene::BuiltScene<G>& scene, Columns
   const std::vector<const mpm::PersistentField*> shown = list.frame_fields();
   if (shown.empty()) return std::nullopt;
   const auto* dec = scene.solver->decomposition();
-  const auto& grid = dec ? dec->global() : scene.solver->grid();  // (decomposed: gathered on rank 0)
+  const auto& local = scene.solver->grid();
+  const auto& grid = dec ? dec->global() : local;
   std::array<std::size_t, 3> nodes{1, 1, 1};
   for (int a = 0; a < D; ++a) nodes[a] = static_cast<std::size_t>(grid.periodic[a] ? grid.cells[a] : grid.cells[a] + 1);
   std::array<double, 3> origin{0, 0, 0}, spacing{0, 0, 0};
@@ -93,24 +94,30 @@ std::optional<io::NodeGrid> node_grid(const scene::BuiltScene<G>& scene, Columns
     spacing[a] = grid.h_m;
   }
   io::NodeGrid ng(D, origin, spacing, nodes);
-  for (const mpm::PersistentField* f : shown) {
-    const auto& stored = std::get<std::span<double>>(f->data);
-    auto& values = column.add(nodes[0] * nodes[1] * nodes[2]);
-    if (dec) {
-      values = mpm::gather_physical_nodes<D>(*dec, scene.solver->grid(), stored);
-      if (comm::is_root()) ng.scalar(f->shown_as(), values);
-      continue;
+  std::vector<std::size_t> at;  // the local flat index of each node written, x fastest
+  if (dec) {
+    const mpm::OwnedNodes box = mpm::owned_physical_nodes(*dec, local);
+    std::array<std::size_t, 3> begin{}, extent{};
+    for (int a = 0; a < 3; ++a) {
+      begin[a] = static_cast<std::size_t>(box.begin[a]);
+      extent[a] = static_cast<std::size_t>(box.extent[a]);
     }
-    for (std::size_t k = 0; k < nodes[2]; ++k) {
-      for (std::size_t j = 0; j < nodes[1]; ++j) {
+    ng.set_part(begin, extent);
+    mpm::for_owned_physical_nodes(*dec, local, [&](std::size_t flat, const auto&) { at.push_back(flat); });
+  } else {
+    for (std::size_t k = 0; k < nodes[2]; ++k)
+      for (std::size_t j = 0; j < nodes[1]; ++j)
         for (std::size_t i = 0; i < nodes[0]; ++i) {
           const int logical[3] = {static_cast<int>(i), static_cast<int>(j), static_cast<int>(k)};
           int flat = 0;
-          for (int a = 0; a < D; ++a) flat += grid.storage_index(a, logical[a]) * grid.stride(a);
-          values[i + nodes[0] * (j + nodes[1] * k)] = stored[static_cast<std::size_t>(flat)];
+          for (int a = 0; a < D; ++a) flat += local.storage_index(a, logical[a]) * local.stride(a);
+          at.push_back(static_cast<std::size_t>(flat));
         }
-      }
-    }
+  }
+  for (const mpm::PersistentField* f : shown) {
+    const auto& stored = std::get<std::span<double>>(f->data);
+    auto& values = column.add(at.size());
+    for (std::size_t n = 0; n < at.size(); ++n) values[n] = stored[at[n]];
     ng.scalar(f->shown_as(), values);
   }
   return ng;
@@ -119,20 +126,15 @@ std::optional<io::NodeGrid> node_grid(const scene::BuiltScene<G>& scene, Columns
 }  // namespace
 
 template <class G>
-void write_frame(io::FrameWriter* frames, const scene::BuiltScene<G>& scene) {
+void write_frame(io::FrameWriter& frames, const scene::BuiltScene<G>& scene) {
   auto& solver = *scene.solver;
-  // (decomposed: rank 0 writes every rank's points; the frame views the bodies' arrays, so it is
-  // written before they shrink back)
-  with_every_point_on_root(solver, [&] {
-    io::Frame frame;
-    frame.time = solver.time_s();
-    frame.step = solver.steps();
-    Columns column(64 * static_cast<std::size_t>(solver.body_count()) + 16);
-    if (frames != nullptr)
-      for (int b = 0; b < solver.body_count(); ++b) frame.bodies.push_back(body_cloud(scene, b, column));
-    if (auto grid = node_grid(scene, column)) frame.grid = std::move(*grid);
-    if (frames != nullptr) frames->write(frame);
-  });
+  io::Frame frame;
+  frame.time = solver.time_s();
+  frame.step = solver.steps();
+  Columns column(64 * static_cast<std::size_t>(solver.body_count()) + 16);
+  for (int b = 0; b < solver.body_count(); ++b) frame.bodies.push_back(body_cloud(scene, b, column));
+  if (auto grid = node_grid(scene, column)) frame.grid = std::move(*grid);
+  frames.write(frame);
 }
 
 template <class G>
@@ -200,7 +202,7 @@ std::vector<double> series_row(const scene::BuiltScene<G>& scene) {
 }
 
 #define OOBLECK_INSTANTIATE_OUTPUT(G)                                            \
-  template void write_frame(io::FrameWriter*, const scene::BuiltScene<G>&);      \
+  template void write_frame(io::FrameWriter&, const scene::BuiltScene<G>&);      \
   template std::vector<std::string> series_columns(const scene::BuiltScene<G>&); \
   template std::vector<double> series_row(const scene::BuiltScene<G>&)
 OOBLECK_INSTANTIATE_OUTPUT(mpm::PlaneStrain);

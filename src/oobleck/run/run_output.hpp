@@ -13,7 +13,8 @@ namespace oobleck::run {
 
 /// f() on every rank while rank 0's bodies hold every rank's points (appended in rank order,
 /// mpm/halo.hpp) and the other ranks' their own; afterwards each body holds only its own again.
-/// For what rank 0 writes of the whole run (frames, checkpoints). One rank: f().
+/// For measurements that rank 0 makes over every point (the intrusion and wheel analyses). One
+/// rank: f().
 template <class G, class F>
 void with_every_point_on_root(mpm::Solver<G>& solver, F&& f) {
   if (!solver.decomposition()) {
@@ -29,9 +30,10 @@ void with_every_point_on_root(mpm::Solver<G>& solver, F&& f) {
 /// Write one frame: per body its points' position, velocity, stress, pressure (fluid_pressure for
 /// the fluid), mass and volume; the grains' f, phi, tau_bar, regime, gamma_dot_p; the fluid's phi
 /// and J; and the nodal porosity on the physical nodes when there is a mixture. Decomposed runs:
-/// called on every rank, which gathers the whole frame on rank 0; `frames` is nullptr elsewhere.
+/// called on every rank with its writer (io::Writers::every_rank), each writing its own points
+/// and nodes.
 template <class G>
-void write_frame(io::FrameWriter* frames, const scene::BuiltScene<G>& scene);
+void write_frame(io::FrameWriter& frames, const scene::BuiltScene<G>& scene);
 
 /// series.csv: time, step; per body its kinetic energy, momentum, mass and largest speed; per
 /// [[body]] entry its centre of mass and contact force, and its motor's ω and torque.

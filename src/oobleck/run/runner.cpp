@@ -87,7 +87,7 @@ class SceneRun {
   void decompose();
   void make_run_folder();
   void start(std::optional<io::FrameWriter>& frames, std::optional<io::SeriesWriter>& series);
-  void write_frame(io::FrameWriter* frames);
+  void write_frame(io::FrameWriter& frames);
   void take_due_snapshots(bool final_step);
   void check_finite() const;
   /// Everything a restart needs (run/checkpoint_state.hpp): solver, snapshots, analysis.
@@ -97,6 +97,8 @@ class SceneRun {
   nlohmann::json summary(long steps_run, bool complete, double wall_s) const;
 
   mpm::Solver<G>& solver() const { return *scene_.solver; }
+  /// Who writes the frames and checkpoints: every rank of a decomposed run together.
+  io::Writers writers() const { return solver().decomposition() ? io::Writers::every_rank : io::Writers::one; }
 
   const SceneConfig& cfg_;
   RunOptions opt_;
@@ -171,21 +173,21 @@ void SceneRun<G>::start(std::optional<io::FrameWriter>& frames, std::optional<io
     const io::Checkpoint cp = io::read_checkpoint(checkpoint_path(opt_.out_dir));
     restore(cp);
     decompose();
+    frames.emplace(io::FrameWriter::resume(opt_.out_dir, cp.step(), "frames", writers()));
     if (!root) return;
     // New [time] settings (RunOptions::restart_overrides): a later plain --restart keeps them.
     if (!opt_.restart_overrides.empty())
       io::write_file_atomically(stored_scene_path(opt_.out_dir), cfg_.resolved_toml, "scene copy");
-    frames.emplace(io::FrameWriter::resume(opt_.out_dir, cp.step()));
     series.emplace(io::SeriesWriter::resume(opt_.out_dir + "/series.csv", series_columns(scene_), cp.time()));
     return;
   }
   decompose();
   if (root) {
     io::write_file_atomically(stored_scene_path(opt_.out_dir), cfg_.resolved_toml, "scene copy");
-    frames.emplace(opt_.out_dir);
     series.emplace(opt_.out_dir + "/series.csv", series_columns(scene_));
   }
-  write_frame(frames ? &*frames : nullptr);
+  frames.emplace(opt_.out_dir, "frames", writers());
+  write_frame(*frames);
   const auto row = series_row(scene_);
   if (series) series->row(row);
   analysis_->sample();
@@ -193,7 +195,7 @@ void SceneRun<G>::start(std::optional<io::FrameWriter>& frames, std::optional<io
 }
 
 template <class G>
-void SceneRun<G>::write_frame(io::FrameWriter* frames) {
+void SceneRun<G>::write_frame(io::FrameWriter& frames) {
   run::write_frame(frames, scene_);
   analysis_->at_frame();
 }
@@ -231,17 +233,14 @@ mpm::FieldList SceneRun<G>::state_fields() {
 
 template <class G>
 void SceneRun<G>::write_checkpoint() {
-  with_every_point_on_root(solver(), [&] {  // (decomposed: rank 0 writes every rank's points)
-    if (!comm::is_root()) return;
-    io::CheckpointWriter cp(checkpoint_path(opt_.out_dir));
-    cp.set_step(solver().steps());
-    cp.set_time(solver().time_s());
-    cp.set_config(cfg_.resolved_toml);
-    cp.attribute("dt", scene_.dt_s);
-    cp.attribute("threads", static_cast<std::int64_t>(solver().threads()));
-    save_fields(cp, state_fields());
-    cp.commit();
-  });
+  io::CheckpointWriter cp(checkpoint_path(opt_.out_dir), writers());  // (decomposed: every rank)
+  cp.set_step(solver().steps());
+  cp.set_time(solver().time_s());
+  cp.set_config(cfg_.resolved_toml);
+  cp.attribute("dt", scene_.dt_s);
+  cp.attribute("threads", static_cast<std::int64_t>(solver().threads()));
+  save_fields(cp, state_fields());
+  cp.commit();
 }
 
 template <class G>
@@ -306,7 +305,7 @@ nlohmann::json SceneRun<G>::run() {
     const long k = s - base;
     if (k % every_sample == 0 || final_step) analysis_->sample();
     take_due_snapshots(final_step);
-    if (k % every_frame == 0 || final_step) write_frame(frames ? &*frames : nullptr);
+    if (k % every_frame == 0 || final_step) write_frame(*frames);
     if (k % every_series == 0 || final_step) {
       const auto row = series_row(scene_);
       if (series) series->row(row);

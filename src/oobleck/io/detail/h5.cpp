@@ -4,6 +4,12 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
+// Parallel HDF5 (files that every rank writes) in a build with MPI: CMakeLists.txt links Debian's
+// libhdf5-openmpi then.
+#if defined(OOBLECK_HAVE_MPI) && defined(H5_HAVE_PARALLEL)
+#define OOBLECK_PARALLEL_HDF5 1
+#include <mpi.h>  // (MPI_COMM_WORLD for parallel HDF5's file access; core/comm.cpp does the rest)
+#endif
 
 #include "oobleck/io/hdf5_state.hpp"
 
@@ -83,10 +89,17 @@ std::string last_error() {
   return out;
 }
 
-Handle create_file(const std::string& path, bool large_attributes) {
+Handle create_file(const std::string& path, bool large_attributes, bool every_rank) {
   silence_errors();
   Handle fapl(H5Pcreate(H5P_FILE_ACCESS));
   if (large_attributes) H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V18, H5F_LIBVER_LATEST);
+  if (every_rank) {
+#ifdef OOBLECK_PARALLEL_HDF5
+    H5Pset_fapl_mpio(fapl.get(), MPI_COMM_WORLD, MPI_INFO_NULL);
+#else
+    throw std::logic_error(fmt::format("'{}': a file of every rank needs a build with MPI", path));
+#endif
+  }
   Handle f(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()));
   if (!f.valid()) throw std::runtime_error(failure(fmt::format("cannot create HDF5 file '{}'", path)));
   return f;
@@ -97,20 +110,56 @@ Handle open_file_readonly(const std::string& path) {
   return Handle(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
 }
 
+Handle open_file_readwrite(const std::string& path, bool large_attributes) {
+  silence_errors();
+  Handle fapl(H5Pcreate(H5P_FILE_ACCESS));
+  if (large_attributes) H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V18, H5F_LIBVER_LATEST);
+  Handle f(H5Fopen(path.c_str(), H5F_ACC_RDWR, fapl.get()));
+  if (!f.valid()) throw std::runtime_error(failure(fmt::format("cannot open HDF5 file '{}' for writing", path)));
+  return f;
+}
+
+bool written_by_every_rank([[maybe_unused]] hid_t loc) {
+#ifdef OOBLECK_PARALLEL_HDF5
+  Handle file(H5Iget_file_id(loc));
+  Handle fapl(H5Fget_access_plist(file.get()));
+  return H5Pget_driver(fapl.get()) == H5FD_MPIO;
+#else
+  return false;
+#endif
+}
+
 Handle create_group(hid_t loc, const std::string& name) {
   Handle g(H5Gcreate2(loc, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
   if (!g.valid()) throw std::runtime_error(failure(fmt::format("cannot create HDF5 group '{}'", name)));
   return g;
 }
 
-void write_dataset(hid_t loc, const std::string& name, hid_t type, const std::vector<std::uint64_t>& shape,
-                   const void* data) {
-  Handle space = shape.empty() ? scalar_space() : simple_space(shape);
-  Handle dset(H5Dcreate2(loc, name.c_str(), type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+void write_dataset_part(hid_t loc, const std::string& name, hid_t type, const std::vector<std::uint64_t>& shape,
+                        const std::vector<std::uint64_t>& start, const std::vector<std::uint64_t>& count,
+                        const void* data, hid_t link_properties) {
+  Handle file_space = simple_space(shape);
+  Handle dset(H5Dcreate2(loc, name.c_str(), type, file_space.get(), link_properties, H5P_DEFAULT, H5P_DEFAULT));
   if (!dset.valid()) throw std::runtime_error(failure(fmt::format("cannot create dataset '{}'", name)));
-  std::uint64_t count = 1;
-  for (auto n : shape) count *= n;
-  if (count > 0 && H5Dwrite(dset.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
+  std::uint64_t n = 1;
+  for (auto c : count) n *= c;
+  const bool collective = written_by_every_rank(loc);
+  if (n == 0 && !collective) return;
+  Handle memory_space;
+  if (n > 0) {
+    const std::vector<hsize_t> at(start.begin(), start.end()), extent(count.begin(), count.end());
+    H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, at.data(), nullptr, extent.data(), nullptr);
+    memory_space = simple_space(count);
+  } else {  // (a rank without values still takes part in the collective write)
+    H5Sselect_none(file_space.get());
+    memory_space = Handle(H5Scopy(file_space.get()));
+  }
+  Handle transfer(H5Pcreate(H5P_DATASET_XFER));
+#ifdef OOBLECK_PARALLEL_HDF5
+  if (collective) H5Pset_dxpl_mpio(transfer.get(), H5FD_MPIO_COLLECTIVE);
+#endif
+  const double none = 0.0;
+  if (H5Dwrite(dset.get(), type, memory_space.get(), file_space.get(), transfer.get(), n > 0 ? data : &none) < 0) {
     throw std::runtime_error(failure(fmt::format("cannot write dataset '{}'", name)));
   }
 }
@@ -169,6 +218,18 @@ bool read_attribute(hid_t loc, const std::string& name, std::string& value) {
   const auto end = buf.find('\0');
   value = end == std::string::npos ? buf : buf.substr(0, end);
   return true;
+}
+
+bool read_attribute(hid_t loc, const std::string& name, std::vector<std::int64_t>& values) {
+  if (!has_attribute(loc, name)) return false;
+  Handle attr(H5Aopen(loc, name.c_str(), H5P_DEFAULT));
+  if (!attr.valid()) return false;
+  Handle space(H5Aget_space(attr.get()));
+  Handle type(H5Aget_type(attr.get()));
+  const hssize_t n = H5Sget_simple_extent_npoints(space.get());
+  if (n < 0 || H5Tget_class(type.get()) != H5T_INTEGER) return false;
+  values.assign(static_cast<std::size_t>(n), 0);
+  return n == 0 || H5Aread(attr.get(), H5T_NATIVE_INT64, values.data()) >= 0;
 }
 
 }  // namespace oobleck::io::h5

@@ -47,16 +47,28 @@ std::string last_error();
 /// Create (truncate) a file. Throws std::runtime_error naming `path` on failure.
 /// `large_attributes` selects the HDF5 1.8+ file format, whose dense attribute storage lifts
 /// the 64 KiB limit on one object's attributes (used by checkpoints for the configuration text).
-Handle create_file(const std::string& path, bool large_attributes = false);
+/// `every_rank`: every MPI rank creates the file together (parallel HDF5, MPI-IO); each then
+/// makes the same calls for groups, datasets and attributes, with the same values, and writes
+/// its own block of each dataset (write_dataset_part); closing is collective too. Only in a
+/// decomposed run (comm::size() > 1) of a build with MPI.
+Handle create_file(const std::string& path, bool large_attributes = false, bool every_rank = false);
 /// Open a file read-only; returns an invalid handle when it cannot be opened.
 Handle open_file_readonly(const std::string& path);
+/// Open an existing file for writing by this process alone; throws std::runtime_error naming it.
+Handle open_file_readwrite(const std::string& path, bool large_attributes = false);
+/// Whether every rank writes the file that `loc` belongs to (create_file's `every_rank`).
+bool written_by_every_rank(hid_t loc);
 
 Handle create_group(hid_t loc, const std::string& name);
 
-/// Write a contiguous dataset of `type` (a native type) with the given shape.
-/// An empty shape writes a scalar dataset. Throws std::runtime_error on failure.
-void write_dataset(hid_t loc, const std::string& name, hid_t type, const std::vector<std::uint64_t>& shape,
-                   const void* data);
+/// A dataset of `shape` of which this process writes the block that starts at `start` and spans
+/// `count` (one entry per axis; `data` holds the block, last axis fastest). In a file that every
+/// rank writes, every rank calls it with the same name and shape (the write is collective; a
+/// rank without values passes a zero count); otherwise start = 0 and count = shape write all.
+/// `link_properties`: H5Dcreate2's link creation list (e.g. one that creates missing groups).
+void write_dataset_part(hid_t loc, const std::string& name, hid_t type, const std::vector<std::uint64_t>& shape,
+                        const std::vector<std::uint64_t>& start, const std::vector<std::uint64_t>& count,
+                        const void* data, hid_t link_properties = H5P_DEFAULT);
 
 void write_attribute(hid_t loc, const std::string& name, double value);
 void write_attribute(hid_t loc, const std::string& name, std::int64_t value);
@@ -69,5 +81,6 @@ bool has_attribute(hid_t loc, const std::string& name);
 bool read_attribute(hid_t loc, const std::string& name, double& value);
 bool read_attribute(hid_t loc, const std::string& name, std::int64_t& value);
 bool read_attribute(hid_t loc, const std::string& name, std::string& value);
+bool read_attribute(hid_t loc, const std::string& name, std::vector<std::int64_t>& values);
 
 }  // namespace oobleck::io::h5
