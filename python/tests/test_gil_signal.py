@@ -35,7 +35,8 @@ def test_long_call_releases_the_gil():
 
 
 SCRIPT = r"""
-import sys
+import faulthandler, signal, sys
+faulthandler.register(signal.SIGUSR1)  # the test's diagnosis if the run does not stop
 sys.path.insert(0, sys.argv[1])
 import oobleck
 try:
@@ -58,7 +59,14 @@ def test_sigint_stops_run_with_checkpoint(root, tmp_path):
     time.sleep(0.5)
     t0 = time.monotonic()
     p.send_signal(signal.SIGINT)
-    stdout, stderr = p.communicate(timeout=10)
+    try:
+        stdout, stderr = p.communicate(timeout=10)
+    except subprocess.TimeoutExpired:
+        p.send_signal(signal.SIGUSR1)  # every thread's Python stack to stderr
+        time.sleep(0.5)
+        p.kill()
+        stdout, stderr = p.communicate()
+        raise AssertionError(f"the run did not stop within 10 s of SIGINT; its stderr:\n{stderr}") from None
     elapsed = time.monotonic() - t0
     assert p.returncode == 130 and "interrupted" in stdout, stderr
     assert elapsed < 1.0, elapsed
