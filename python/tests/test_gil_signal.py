@@ -37,6 +37,9 @@ def test_long_call_releases_the_gil():
 SCRIPT = r"""
 import faulthandler, signal, sys
 faulthandler.register(signal.SIGUSR1)  # the test's diagnosis if the run does not stop
+# Ctrl-C as at a terminal: a shell that starts the tests in the background (`nohup ... &`) hands
+# them SIGINT ignored, and Python then installs no KeyboardInterrupt handler.
+signal.signal(signal.SIGINT, signal.default_int_handler)
 sys.path.insert(0, sys.argv[1])
 import oobleck
 try:
