@@ -40,5 +40,6 @@ void add_fit_command(CLI::App& rheology);
 void add_point_commands(CLI::App& app);
 void add_run_command(CLI::App& app);
 void add_reproduce_command(CLI::App& app);
+void add_sweep_command(CLI::App& app);
 
 }  // namespace oobleck::cli

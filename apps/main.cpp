@@ -33,6 +33,7 @@ int run_cli(int argc, char** argv) {
   oobleck::cli::add_point_commands(app);
   oobleck::cli::add_run_command(app);
   oobleck::cli::add_reproduce_command(app);
+  oobleck::cli::add_sweep_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

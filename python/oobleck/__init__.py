@@ -749,3 +749,4 @@ def open_run(dir) -> Run:
     if not isinstance(dir, (str, os.PathLike)):
         raise InputError(f"dir = {dir!r} ({type(dir).__name__}): must be a folder path")
     return Run(dir)
+from .sweep import sweep  # noqa: E402,F401  (oobleck.sweep: a grid of runs through the CLI, python/oobleck/sweep.py)
