@@ -64,6 +64,16 @@ struct SolverOptions {
   Vec<G::ncomp> gravity_m_s2 = Vec<G::ncomp>::Zero();  ///< gravitational acceleration
   int threads = 0;                                     ///< OpenMP threads (0: omp default)
   MixtureOptions<G> mixture;                           ///< used when a Fluid body exists
+  /// Linear kernels only (0: off): selective nodal mass scaling of the force update,
+  /// v_i = mv_i/m_i + Δt f_i/m'_i with m'_i = max(m_i, linear_mass_floor · ρ̄_b V_i) (ρ̄_b = Σ m_p / Σ V0_p
+  /// of the body, V_i = h^D, per radian max(h² |r_i|, h³/8)). A node that a body covers only at
+  /// the edge of its points' supports has a mass fraction ε of a full node while ∇N of linear
+  /// weights does not vanish there: its stable step is √ε of a full node's, and the paper's
+  /// scenes blew up on such nodes (points crossing a grid line next to the intruder's face, a
+  /// wheel whose points lie on grid lines). A floor of (Δt/Δt_crit)² (the scene builder sets
+  /// cfl², docs/mpm.md) gives every node at least a full node's stable step. B-splines do not
+  /// need it (∇N vanishes with N).
+  double linear_mass_floor = 0.0;
 };
 
 /// Phase 6 for one body, by the calling thread of a region: G2P's blocks of `task` in static
@@ -320,6 +330,7 @@ class Solver {
       particles_to_grid_all<K>();                           // 2. P2G: shape functions, mass, momentum, forces, gravity
       if (halo_) timed_exchange([&] { sum_to_owners(); });  // (decomposed: partial sums to the owners)
       clock.lap(timings_.p2g);
+      if (opt_.shape == ShapeKind::Linear && opt_.linear_mass_floor > 0.0) prepare_mass_floor();
       prepare_rigid_and_contact();
       update_grid_and_couple(                           // 3. grid: walls fold ghosts, rigid predictions; porosity,
           [this] { scatter_contact_gradients<K>(); });  // buoyancy (E28), v = (mv + Δt f)/m,
@@ -474,7 +485,7 @@ class Solver {
           [&](const parallel::Team& team) {
             const parallel::Range r = team.share(nn);
             for (GridField<G>* sf : solids_)
-              update_grid_velocity(*sf, dt, static_cast<int>(r.begin), static_cast<int>(r.end));
+              for (auto i = static_cast<int>(r.begin); i < static_cast<int>(r.end); ++i) predict_node(*sf, i, dt);
           },
           nn >= kParallelMinNodes);
       return;
@@ -724,6 +735,31 @@ class Solver {
     }
   }
 
+  /// The linear kernels' mass floor (SolverOptions::linear_mass_floor): per body floor · Σ m_p / Σ V0_p
+  /// (over every rank), per node the measure V_i; once, at the first step (or when bodies change).
+  void prepare_mass_floor() {
+    if (mass_floor_density_.size() == bodies_.size()) return;
+    std::vector<double> sums(2 * bodies_.size(), 0.0);
+    for (std::size_t b = 0; b < bodies_.size(); ++b)
+      for (std::int64_t p = 0; p < bodies_[b]->size(); ++p) {
+        sums[2 * b] += bodies_[b]->mass_kg[p];
+        sums[2 * b + 1] += bodies_[b]->volume0_m3[p];
+      }
+    if (dec_) comm::sum_ordered(sums);
+    mass_floor_density_.assign(bodies_.size(), 0.0);
+    for (std::size_t b = 0; b < bodies_.size(); ++b)
+      if (!rigid_[b].rigid() && sums[2 * b + 1] > 0.0)
+        mass_floor_density_[b] = opt_.linear_mass_floor * sums[2 * b] / sums[2 * b + 1];
+    const int nn = grid_.node_count();
+    mass_floor_measure_.resize(static_cast<std::size_t>(nn));
+    const double h = grid_.h_m, cell = grid_.cell_volume();
+    for (int i = 0; i < nn; ++i) {
+      Vec<D> x = grid_.node_position(i);
+      if constexpr (G::has_hoop_terms) x[0] = std::fabs(x[0]);
+      mass_floor_measure_[i] = G::has_hoop_terms ? std::max(G::measure(x, cell), 0.125 * cell * h) : cell;
+    }
+  }
+
   void apply_motors() {
     if constexpr (!std::is_same_v<G, Axisymmetric>)
       for (auto& m : motors_) apply_motor(m, *bodies_[m.body], global_grid(), dec_ != nullptr, opt_.dt_s);
@@ -735,11 +771,18 @@ class Solver {
       throw InputError(fmt::format("mpm: {}: body '{}' is a mixture phase, not a solid", what, bodies_[b]->name));
   }
 
-  static void predict_node(GridField<G>& field, int i, double dt) {
+  /// Step 3(b) at node i: v_old = mv/m, v = (mv + Δt f)/m; with the linear kernels' mass floor
+  /// (SolverOptions::linear_mass_floor) v = mv/m + Δt f/max(m, floor).
+  void predict_node(GridField<G>& field, int i, double dt) const {
     const double m = field.mass_kg[i];
     if (m > 0.0) {
       field.velocity_old[i] = field.momentum[i] / m;
-      field.velocity[i] = (field.momentum[i] + dt * field.force_N[i]) / m;
+      const double floor_density = mass_floor_density_.empty() ? 0.0 : mass_floor_density_[&field - fields_.data()];
+      const double m_floor = floor_density * (floor_density > 0.0 ? mass_floor_measure_[i] : 0.0);
+      if (m < m_floor)
+        field.velocity[i] = field.velocity_old[i] + (dt / m_floor) * field.force_N[i];
+      else
+        field.velocity[i] = (field.momentum[i] + dt * field.force_N[i]) / m;
     } else {
       field.velocity_old[i].setZero();
       field.velocity[i].setZero();
@@ -920,7 +963,9 @@ class Solver {
   std::vector<std::int64_t> p2g_outside_;  ///< per body: points whose support left the grid (P2G)
   std::vector<int> law_bodies_;
   std::vector<std::int64_t> law_first_bad_;
-  parallel::StealingShares shares_;  ///< the G2P tasks' and the law bodies' shares
+  parallel::StealingShares shares_;         ///< the G2P tasks' and the law bodies' shares
+  std::vector<double> mass_floor_density_;  ///< per body: linear_mass_floor · ρ̄_b (linear kernels; empty: off)
+  std::vector<double> mass_floor_measure_;  ///< per node: V_i of the mass floor
   double time_s_ = 0.0;
   std::int64_t steps_ = 0;
 };

@@ -232,6 +232,12 @@ GridConfig read_grid(io::TomlReader& top) {
     g.require(grid.origin_m[0] >= 0.0, "origin", grid.origin_m[0], "axisymmetric: r_0 = origin[0] must be >= 0");
   }
   grid.shape = parse_enum(g, "shape_function", ShapeKind::Quadratic, kShapes);
+  if (g.has("linear_mass_floor")) {
+    const double floor = g.number("linear_mass_floor");
+    g.require(floor >= 0.0 && floor <= 1.0, "linear_mass_floor", floor,
+              "must be in [0, 1] (a fraction of a full node's mass; 0: off)");
+    grid.linear_mass_floor = floor;
+  }
   g.finish();
   return grid;
 }

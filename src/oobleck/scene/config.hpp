@@ -35,6 +35,9 @@ struct GridConfig {
   double cell_size_m = 0.0;                 ///< [m] h
   std::array<int, 3> cells{1, 1, 1};        ///< derived: size/h (must be an integer)
   ShapeKind shape = ShapeKind::Quadratic;
+  /// [-] linear kernels: nodal mass floor as a fraction of a full node's mass (mpm::SolverOptions::
+  /// linear_mass_floor); unset: (Δt/Δt_crit)², i.e. cfl². 0 turns it off.
+  std::optional<double> linear_mass_floor;
 };
 
 struct FluidConfig {
