@@ -25,7 +25,8 @@ TEST(AnalysisJson, WheelSummaryKeys) {
   const nlohmann::json j = to_json(summarize_wheel(h, c), c);
   EXPECT_NEAR(j.at("distance").get<double>(), 1.2, 1e-12);
   EXPECT_DOUBLE_EQ(j.at("bed_surface").get<double>(), 0.5);
-  EXPECT_TRUE(j.at("stays_at_surface").get<bool>());
+  EXPECT_TRUE(j.at("runs_on_surface").get<bool>());  // lowest 0.58 m >= 0.65 - 0.15/2
+  EXPECT_NEAR(j.at("runs_on_surface_lowest_hub").get<double>(), 0.575, 1e-15);
   EXPECT_FALSE(j.at("sinks").get<bool>());
   EXPECT_TRUE(to_json(FlowStop{}).at("time").is_null());
 }

@@ -37,33 +37,47 @@ TEST(Wheel, UnwrapsThePeriodicTrack) {
   EXPECT_THROW(unwrap_periodic(h.x_m, 0.0), InputError);
 }
 
-TEST(Wheel, FastWheelStaysAtTheSurface) {
-  const HubTrack h = track(1.5, 1.2, 0.65, 0.05, 2.0, 0.005);
+TEST(Wheel, FastWheelRunsOnTheSurface) {
+  const HubTrack h = track(1.5, 1.2, 0.65, 0.03, 2.0, 0.005);
   WheelCriteria c;  // L = 2 m, R = 0.15 m, bed surface 0.5 m
   const WheelSummary s = summarize_wheel(h, c);
   EXPECT_NEAR(s.duration_s, 2.0, 1e-12);
   EXPECT_NEAR(s.hub_height_initial_m, 0.65, 1e-15);
-  EXPECT_NEAR(s.hub_height_final_m, 0.55, 1e-12);
-  EXPECT_NEAR(s.hub_height_min_m, 0.55, 1e-12);
+  EXPECT_NEAR(s.hub_height_final_m, 0.59, 1e-12);
+  EXPECT_NEAR(s.hub_height_min_m, 0.59, 1e-12);
   EXPECT_NEAR(s.hub_height_min_time_s, 2.0, 1e-12);
-  EXPECT_NEAR(s.height_loss_m, 0.10, 1e-12);
+  EXPECT_NEAR(s.height_loss_m, 0.06, 1e-12);
   EXPECT_NEAR(s.distance_m, 2.4, 1e-12);
   EXPECT_NEAR(s.mean_forward_speed_m_per_s, 1.2, 1e-12);
-  EXPECT_TRUE(s.stays_at_surface);
+  EXPECT_TRUE(s.runs_on_surface);  // lowest hub 0.59 m >= 0.65 - 0.15/2
+  EXPECT_NEAR(s.runs_on_surface_lowest_hub_m, 0.575, 1e-15);
   EXPECT_FALSE(s.sinks);
   EXPECT_FALSE(s.ever_below_surface);
+}
+
+TEST(Wheel, RunsAndSinksAreHalfARadiusApart) {
+  // A hub that drops 0.1 m (less than one radius, more than half of one) ends above the bed
+  // surface: it neither runs on the surface nor sinks. Dropping 0.06 m it runs; 0.16 m, it sinks.
+  const WheelCriteria c;  // R = 0.15 m, surface 0.5 m; the hub starts at 0.65 m
+  const WheelSummary between = summarize_wheel(track(1.5, 1.2, 0.65, 0.10, 1.0, 0.01), c);
+  EXPECT_FALSE(between.runs_on_surface);
+  EXPECT_FALSE(between.sinks);
+  EXPECT_TRUE(summarize_wheel(track(1.5, 1.2, 0.65, 0.06, 1.0, 0.01), c).runs_on_surface);
+  const WheelSummary deep = summarize_wheel(track(1.5, 1.2, 0.65, 0.16, 1.0, 0.01), c);
+  EXPECT_TRUE(deep.sinks);
+  EXPECT_FALSE(deep.runs_on_surface);
 }
 
 TEST(Wheel, SlowWheelSinks) {
   const HubTrack h = track(1.0, 0.05, 0.65, 0.2, 1.5, 0.01);
   const WheelSummary s = summarize_wheel(h, WheelCriteria{});
   EXPECT_NEAR(s.hub_height_final_m, 0.35, 1e-12);
-  EXPECT_FALSE(s.stays_at_surface);
+  EXPECT_FALSE(s.runs_on_surface);
   EXPECT_TRUE(s.sinks);
   EXPECT_TRUE(s.ever_below_surface);
-  // A wheel that holds its height but does not move forward does not "stay at the surface".
+  // A wheel that holds its height but does not move forward does not "run on the surface".
   const WheelSummary still = summarize_wheel(track(1.0, 0.0, 0.65, 0.0, 1.5, 0.01), WheelCriteria{});
-  EXPECT_FALSE(still.stays_at_surface);
+  EXPECT_FALSE(still.runs_on_surface);
 }
 
 TEST(Wheel, RejectsBadTracks) {

@@ -110,7 +110,8 @@ nlohmann::json to_json(const WheelSummary& s, const WheelCriteria& c) {
           {"distance", num(s.distance_m)},
           {"duration", num(s.duration_s)},
           {"mean_forward_speed", num(s.mean_forward_speed_m_per_s)},
-          {"stays_at_surface", s.stays_at_surface},
+          {"runs_on_surface", s.runs_on_surface},
+          {"runs_on_surface_lowest_hub", num(s.runs_on_surface_lowest_hub_m)},
           {"sinks", s.sinks},
           {"ever_below_surface", s.ever_below_surface}};
 }

@@ -33,8 +33,8 @@ nlohmann::json to_json(const std::vector<ShearProfile>& profiles);
 nlohmann::json to_json(const FlowStop& stop);
 nlohmann::json to_json(const OuterArrest& arrest);
 /// {hub_height_initial, hub_height_final, hub_height_min, hub_height_min_time, height_loss,
-///  bed_surface, wheel_radius, distance, duration, mean_forward_speed, stays_at_surface, sinks,
-///  ever_below_surface}
+///  bed_surface, wheel_radius, distance, duration, mean_forward_speed, runs_on_surface,
+///  runs_on_surface_lowest_hub, sinks, ever_below_surface}
 nlohmann::json to_json(const WheelSummary& summary, const WheelCriteria& criteria);
 
 }  // namespace oobleck::analysis

@@ -56,7 +56,8 @@ WheelSummary summarize_wheel(const HubTrack& hub, const WheelCriteria& c) {
   s.height_loss_m = s.hub_height_initial_m - s.hub_height_final_m;
   s.distance_m = c.forward * (s.x_unwrapped_m.back() - s.x_unwrapped_m.front());
   s.mean_forward_speed_m_per_s = s.distance_m / s.duration_s;
-  s.stays_at_surface = s.height_loss_m < c.wheel_radius_m && s.distance_m > 0.0;
+  s.runs_on_surface_lowest_hub_m = s.hub_height_initial_m - 0.5 * c.wheel_radius_m;
+  s.runs_on_surface = s.hub_height_min_m >= s.runs_on_surface_lowest_hub_m && s.distance_m > 0.0;
   s.sinks = s.hub_height_final_m < c.bed_surface_m;
   s.ever_below_surface = s.hub_height_min_m < c.bed_surface_m;
   return s;

@@ -1,6 +1,6 @@
 #pragma once
 // S4 (running on oobleck, paper Figs. 11-12, scenes.md S4): hub height and distance travelled
-// across a periodic track, the "stays at the surface" / "sinks" verdicts, and the free-surface
+// across a periodic track, the "runs on the surface" / "sinks" verdicts, and the free-surface
 // height profile from a nodal volume-fraction field, and the point-to-point scatter of the granular
 // pressure under the wheel (the SI's ringing figure). See docs/analysis.md "Wheel".
 #include <cstddef>
@@ -40,10 +40,16 @@ struct WheelSummary {
   double height_loss_m = 0.0;               ///< initial - final
   double distance_m = 0.0;                  ///< forward * (x_unwrapped_last - x_unwrapped_first)
   double mean_forward_speed_m_per_s = 0.0;  ///< distance / duration
-  bool stays_at_surface = false;            ///< height_loss < wheel radius and distance > 0
-  bool sinks = false;                       ///< final hub height below the initial bed surface
-  bool ever_below_surface = false;          ///< minimum hub height below the initial bed surface
-  std::vector<double> x_unwrapped_m;        ///< unwrapped hub x for every sample
+  /// The hub never more than half a wheel radius below its start (min ≥ initial − R/2: the
+  /// paddles reach at most ~0.2 R below the surface when the tips carry the wheel, whose hub
+  /// then rides between surface + R cos 45° and surface + R) and distance > 0.
+  bool runs_on_surface = false;
+  double runs_on_surface_lowest_hub_m = 0.0;  ///< initial − R/2, the criterion's lowest hub height
+  bool sinks = false;                         ///< final hub height below the initial bed surface
+  /// (The two are R/2 apart: the hub starts at the surface + R, its lowest paddle tip on the
+  /// surface; a wheel may meet neither.)
+  bool ever_below_surface = false;    ///< minimum hub height below the initial bed surface
+  std::vector<double> x_unwrapped_m;  ///< unwrapped hub x for every sample
 };
 
 /// Summarise a hub track (>= 2 samples, strictly increasing times, equal sizes).
