@@ -328,6 +328,42 @@ TEST(Contact, PrescribedIntruderMovesExactlyAtV0) {
   EXPECT_NEAR(bed.total_momentum()[1] - Pz0, -Jz, 1e-12 * std::fabs(Jz));
 }
 
+TEST(Contact, NormalUnderAFlatFaceIsMinusEzAtEveryRadius) {
+  // A prescribed flat-ended rod (radius R = 6 h, its face on the grid line z = 16 h) resting on a
+  // uniform elastic bed, axisymmetric, one step from rest without gravity. Under the face, at every
+  // node of the face's row from the axis to two cells inside the rod's edge (beyond the reach of
+  // the corner through the cubic kernel), the contact normal is -e_z: the bodies' densities are
+  // uniform, so their smoothed density varies along z only. The
+  // axis is a mirror plane: the normal at r = 0 has no radial part either. (With the per-radian
+  // masses m_p = rho A r_p in the gradient, the normal tilted towards e_r by ~h/r; on the axis the
+  // points on one side only tilted it further.)
+  const double h = 2e-3, R = 6 * h, rho = 1600.0;
+  for (const auto shape : {ShapeKind::Linear, ShapeKind::QuadraticBSpline, ShapeKind::CubicBSpline}) {
+    Grid<2> grid(Vec<2>(0.0, 0.0), h, {16, 24});
+    SolverOptions<Axisymmetric> opt;
+    opt.threads = 1;
+    opt.shape = shape;
+    Solver<Axisymmetric> s(grid, opt);
+    s.boundaries()[0].type = WallType::Axis;
+    auto& bed = s.add_body("bed", Phase::Grains);
+    bed.set_law(std::make_unique<LinearElasticLaw<Axisymmetric>>(elastic(4e6, 0.25)));
+    const double top = 16 * h;
+    fill_box(bed, Vec<2>(0.0, 2 * h), Vec<2>(16 * h, top), h, 2, rho, [](const Vec<2>&) { return Vec<3>::Zero(); });
+    auto& rod = s.add_body("rod");
+    fill_box(rod, Vec<2>(0.0, top), Vec<2>(R, top + 6 * h), h, 2, 2700.0, [](const Vec<2>&) { return Vec<3>::Zero(); });
+    s.set_prescribed_velocity(1, Vec<3>(0.0, -0.1, 0.0));
+    s.add_contact(1, 0.3);
+    s.options().dt_s = s.stable_dt(0.3);
+    s.step();
+    for (int k = 0; k <= 4; ++k) {
+      const int i = grid.storage_index(0, k) * grid.stride(0) + grid.storage_index(1, 16);
+      const Vec<3> n = s.contact_normal_at(0, i);
+      EXPECT_NEAR(n[1], -1.0, 1e-14) << "r = " << k << " h, kernel support " << kernel_support(shape);
+      EXPECT_NEAR(n[0], 0.0, 1e-13) << "r = " << k << " h, kernel support " << kernel_support(shape);
+    }
+  }
+}
+
 // ---- motor ---------------------------------------------------------------------------------------
 
 TEST(Contact, MotorHoldsMeanAngularVelocityOfFreeElasticWheel) {

@@ -258,26 +258,31 @@ TEST(PaperScenes, RestartInsideTheRampContinuesBitForBit) {
   expect_same_state(r.full_cp, r.part_cp);
 }
 
-TEST(PaperScenes, IntruderDrivesAGrowingPlugWithFrontRatioNearTwo) {
-  // S3 on a 2.5 mm grid for 10 ms (v0 = 0.2 m/s, phi = 0.47): material below the intruder moves
-  // with it (u_z >= 0.5 v0) over a region that grows ahead of the tip and sideways past its edge.
-  // The claim measured (experiments: k_l/k_t ~ 2) is asserted on this coarse grid as a
-  // regression check; the paper-resolution runs are in `oobleck reproduce`.
+TEST(PaperScenes, IntruderDrivesAPlugThatGrowsAheadAndSideways) {
+  // S3 on the paper's 1 mm grid for 5 ms (v0 = 0.2 m/s, phi = 0.47): after the impact transient
+  // (the u_z >= 0.5 v0 region jumps about 8 mm ahead of the tip within 1 ms), the region moving
+  // with the intruder keeps growing ahead of the tip and sideways past its edge (measured from 2 to
+  // 5 ms: 8.5 -> 9.7 mm ahead, 1.6 -> 3.4 mm past the edge). The ratio k_l/k_t is not asserted
+  // here: it is the claim under study (docs/results.md, S3), and on the coarser 2.5 mm grid an
+  // earlier version of this test used, the region recedes after 1 ms once the contact normal under
+  // the flat face is -e_z (test Contact.NormalUnderAFlatFaceIsMinusEzAtEveryRadius; the tilted
+  // normal had pushed the grains sideways next to the axis).
   clitest::TempDir d;
-  const auto s = run_paper_scene("intrusion.toml", d / "run", {"cell_size=0.0025", "duration=0.01"});
+  const auto s = run_paper_scene("intrusion.toml", d / "run", {"duration=0.005"});
   const auto& frames = s["velocity_front"]["series"]["frames"];
-  ASSERT_GT(frames.size(), 50u);
-  const auto& early = frames[10];  // 1 ms
+  ASSERT_GT(frames.size(), 45u);
+  const auto& early = frames[20];  // 2 ms
   const auto& late = frames.back();
+  EXPECT_NEAR(early["time"].get<double>(), 0.002, 1e-4);
+  ASSERT_TRUE(early["longitudinal"]["found"].get<bool>());
   ASSERT_TRUE(late["longitudinal"]["found"].get<bool>());
   ASSERT_TRUE(late["transverse"]["found"].get<bool>());
-  EXPECT_GT(late["longitudinal"]["ahead"].get<double>(), early["longitudinal"]["ahead"].get<double>() + 0.0025);
-  EXPECT_GT(late["transverse"]["from_edge"].get<double>(), 0.0025);
-  const double kl = s["k_l"].get<double>(), kt = s["k_t"].get<double>();
-  std::printf("[ measured ] coarse intrusion: k_l = %.3f, k_t = %.3f, k_l/k_t = %.3f\n", kl, kt, kl / kt);
-  EXPECT_GT(kt, 0.0);
-  EXPECT_GE(kl / kt, 1.5);
-  EXPECT_LE(kl / kt, 2.5);
+  const double a2 = early["longitudinal"]["ahead"].get<double>(), a5 = late["longitudinal"]["ahead"].get<double>();
+  const double e2 = early["transverse"]["from_edge"].get<double>(), e5 = late["transverse"]["from_edge"].get<double>();
+  std::printf("[ measured ] intrusion 1 mm: ahead %.2f -> %.2f mm, past the edge %.2f -> %.2f mm (2 -> 5 ms)\n",
+              1e3 * a2, 1e3 * a5, 1e3 * e2, 1e3 * e5);
+  EXPECT_GT(a5, a2 + 0.5e-3);
+  EXPECT_GT(e5, e2 + 1.0e-3);
   // The intruder moved exactly at v0 and the drive had to push (the mixture resists: F_z > 0).
   EXPECT_NEAR(s["bodies"]["intruder"]["velocity"][1].get<double>(), -0.2, 1e-12);
   EXPECT_GT(s["bodies"]["intruder"]["contact_force_last_step"][1].get<double>(), 0.0);

@@ -91,6 +91,28 @@ void for_face_layers(const Grid<D>& grid, int a, bool upper, F&& f) {
 }
 }  // namespace detail
 
+/// The same folding for a nodal gradient of a scalar that walls mirror evenly (contact's mass
+/// gradients): the image's gradient has its component normal to the wall reversed, so the wall
+/// node keeps its tangential part (doubled, as its mass) and loses its normal one; ghost j's image
+/// is added to mirror j. Open faces and periodic axes are left alone.
+template <int D>
+void fold_wall_gradient(const Grid<D>& grid, const BoundaryConditions<D>& bc, std::vector<Vec<D>>& grad) {
+  for (int a = 0; a < D; ++a) {
+    if (grid.periodic[a]) continue;
+    for (int side = 0; side < 2; ++side) {
+      if (bc[2 * a + side].type == WallType::Open) continue;
+      detail::for_face_layers(grid, a, side == 1, [&](int ghost, int mirror, int depth) {
+        Vec<D> img = grad[ghost];
+        img[a] = -img[a];
+        if (depth == 0)
+          grad[ghost] += img;
+        else
+          grad[mirror] += img;
+      });
+    }
+  }
+}
+
 /// Add the reflected ghost-node contributions onto their interior mirrors (see header).
 template <class G>
 void fold_wall_images(const Grid<G::dim>& grid, const BoundaryConditions<G::dim>& bc, GridField<G>& field) {

@@ -18,10 +18,12 @@
 //   a gap leaves it below 1, and at a corner next to empty space it is well below 1. The pure
 //   "both have mass" rule of model.md §8 (θ = 0) acts up to a cell early at every edge (see
 //   docs/contact.md for what it does to a sliding block). The outward normal of the solid is
-//   n = ∇m_b/|∇m_b| with ∇m_b,i = Σ_p m'_p ∇N_i(x_p), m'_p = m_p, or for a free rigid body the
-//   point's mass in the grid's plane (normal_weight: m_p/r_p in axisymmetric mode). At a
-//   node outside the body every ∇N_i(x_p) points from the body's points towards the node:
-//   outward. Only phases that approach the solid, (v_k − v_b)·n < 0, are touched:
+//   n = ∇m_b/|∇m_b| with ∇m_b,i = Σ_p m'_p ∇N_i(x_p), m'_p the point's mass in the grid's plane
+//   (normal_weight: m_p/r_p in axisymmetric mode). At a node outside the body every ∇N_i(x_p)
+//   points from the body's points towards the node: outward. The gradients are folded at walls
+//   like the masses (fold_wall_gradient: walls and the axis are mirror planes), so a face
+//   perpendicular to a wall has its normal along the wall up to the wall node. Only phases that approach the solid,
+//   (v_k − v_b)·n < 0, are touched:
 //     both grains and fluid approach: the three share the mass-weighted normal velocity
 //       v_n* = (m_b v_b·n + m_s v_s·n + m_f v_f·n)/(m_b + m_s + m_f)        (three-body)
 //     one phase k approaches:  v_n* = (m_b v_b·n + m_k v_k·n)/(m_b + m_k)   (two-body)
@@ -278,23 +280,20 @@ void predict_rigid(RigidMotion<G>& rm, GridField<G>& field, const Vec<G::ncomp>&
   }
 }
 
-/// The weight of point p in a contact normal's mass gradient. `plane` (the normals of a free
-/// rigid body's contact, see the Solver): the point's mass in the grid's plane, m_p in plane
-/// strain (and 3D); in axisymmetric mode (masses per radian, m_p = ρ_p A_p r_p, model.md §7)
-/// m_p/r_p = ρ_p A_p, the mass of its cross-section in the (r, z) plane. Σ_p ρ_p A_p ∇N_ip is the
-/// gradient of the smoothed density, zero inside a uniform body: the normal is a property of the
-/// body's shape. The per-radian masses add the gradient of the factor r,
+/// The weight of point p in a contact normal's mass gradient: the point's mass in the grid's
+/// plane, m_p in plane strain (and 3D); in axisymmetric mode (masses per radian, m_p = ρ_p A_p r_p,
+/// model.md §7) m_p/r_p = ρ_p A_p, the mass of its cross-section in the (r, z) plane. Σ_p ρ_p A_p ∇N_ip
+/// is the gradient of the smoothed density, zero inside a uniform body: the normal is a property
+/// of the body's shape. The per-radian masses would add the gradient of the factor r,
 /// Σ_p m_p ∇N_ip ≈ ρ ∫ r ∇N_i dA = −ρ ∫ N_i dA ê_r (−ρ h² ê_r per node) inside a uniform body;
 /// against a surface's own gradient, ~ρ r_i h × (the node's uncovered share of its support), it
-/// tilts the normal of a face perpendicular to the axis towards ê_r by ~h/r_i. Measured on the
-/// floating rod (docs/contact.md, R = 4 h, h = 1 mm): combined normal (0.998, −0.062) at the node
-/// 0.76 h below the bottom face at r = 2 mm; that node then held the fluid radially only, and the
-/// rod floated 0.51 mm deep. Without `plane` (prescribed and deformable bodies): m_p (with
-/// m_p/r_p the prescribed intruder's coarse S3 scene test fails, docs/contact.md).
+/// tilts the normal of a face perpendicular to the axis by ~h/r_i (measured: n_r = −0.37, −0.16,
+/// −0.08 at r = h, 2h, 3h under a flat face with quadratic B-splines; test
+/// Contact.NormalUnderAFlatFaceIsMinusEzAtEveryRadius). Every body, prescribed, free or deformable.
 template <class G>
-double normal_weight(const Body<G>& body, std::int64_t p, bool plane) {
+double normal_weight(const Body<G>& body, std::int64_t p) {
   if constexpr (G::has_hoop_terms)
-    return plane ? body.mass_kg[p] / G::measure(body.x_m[p], 1.0) : body.mass_kg[p];
+    return body.mass_kg[p] / G::measure(body.x_m[p], 1.0);
   else
     return body.mass_kg[p];
 }
@@ -303,14 +302,14 @@ double normal_weight(const Body<G>& body, std::int64_t p, bool plane) {
 /// Σ_p N_ip V_p of a body (its shape cache of the step); `grad` may be null (volume only).
 template <class G, int K>
 void scatter_mass_gradient_and_volume(const Body<G>& body, const ShapeCache<G::dim>& cache,
-                                      std::vector<Vec<G::dim>>* grad, std::vector<double>& volume, bool plane) {
+                                      std::vector<Vec<G::dim>>* grad, std::vector<double>& volume) {
   if (grad)
     for (auto& g : *grad) g.setZero();
   std::fill(volume.begin(), volume.end(), 0.0);
   constexpr int D = G::dim, S = support_of<D>(K);
   const std::int64_t np = body.size();
   for (std::int64_t p = 0; p < np; ++p) {
-    const double m = normal_weight(body, p, plane), V = body.volume_m3[p];
+    const double m = normal_weight(body, p), V = body.volume_m3[p];
     for_each_node<D, S>(cache.template stencil<S>(p), [&](int i, double w, const double* g, const double*) {
       if (grad) (*grad)[i] += m * Eigen::Map<const Vec<D>>(g);
       volume[i] += w * V;
@@ -326,19 +325,33 @@ void scatter_mass_gradient_and_volume(const Body<G>& body, const ShapeCache<G::d
 /// scatter's values.
 template <class G, int K>
 void scatter_mass_gradient_near(const Body<G>& body, const ShapeCache<G::dim>& cache, const Grid<G::dim>& grid,
-                                const Vec<G::dim>& centre, const Vec<G::dim>& half, std::vector<Vec<G::dim>>& grad,
-                                bool plane) {
+                                const Vec<G::dim>& centre, const Vec<G::dim>& half, std::vector<Vec<G::dim>>& grad) {
   constexpr int D = G::dim, S = support_of<D>(K);
   for (auto& g : grad) g.setZero();
   const std::int64_t np = body.size();
   for (std::int64_t p = 0; p < np; ++p) {
     const Vec<D> d = periodic_difference<D>(grid, body.x_m[p], centre);
     if ((d.cwiseAbs().array() > half.array()).any()) continue;
-    const double m = normal_weight(body, p, plane);
+    const double m = normal_weight(body, p);
     for_each_node<D, S>(cache.template stencil<S>(p), [&](int i, double, const double* g, const double*) {
       grad[i] += m * Eigen::Map<const Vec<D>>(g);
     });
   }
+}
+
+/// The contact normal at node i (see the header): the unit vector along ∇m_b,i (minus the
+/// mixture's ∇m_i with the combined normal, `mixture_gradient` non-null); false where the
+/// gradient vanishes.
+template <class G>
+bool contact_normal(const ContactPair<G>& pair, const Vec<G::dim>* mixture_gradient, int i, Vec<G::ncomp>& n) {
+  constexpr int D = G::dim;
+  Vec<D> g = pair.mass_gradient[i];
+  if (mixture_gradient) g -= mixture_gradient[i];
+  const double gn = g.norm();
+  if (!(gn > 0.0)) return false;
+  n.setZero();
+  n.template head<D>() = g / gn;  // Σ m_p ∇N_i(x_p) points away from the body at its boundary
+  return true;
 }
 
 /// Contact impulses at one node (model.md §8; the algorithm is in the header comment).
@@ -457,7 +470,7 @@ Vec<G::ncomp> resolve_contact(ContactPair<G>& pair, const RigidMotion<G>& rm, Gr
                               GridField<G>* fluid, const std::vector<double>& weight, const double* mixture_volume,
                               const std::vector<double>& node_volume, const Vec<G::dim>* mixture_gradient,
                               bool across_ranks, double dt_s) {
-  constexpr int NC = G::ncomp, D = G::dim;
+  constexpr int NC = G::ncomp;
   Vec<NC> J_body = Vec<NC>::Zero(), J_grains = Vec<NC>::Zero();
   int active = 0;
   const bool prescribed = rm.kind == BodyMotion::Prescribed, rigid = rm.rigid();
@@ -471,12 +484,8 @@ Vec<G::ncomp> resolve_contact(ContactPair<G>& pair, const RigidMotion<G>& rm, Gr
     if (!(ms > 0.0) && !(mf > 0.0)) continue;
     if (pair.overlap_threshold > 0.0 && pair.volume_m3[i] + mixture_volume[i] < pair.overlap_threshold * node_volume[i])
       continue;  // both have mass, but their smoothed volumes leave a gap: not touching
-    Vec<D> g = pair.mass_gradient[i];
-    if (mixture_gradient) g -= mixture_gradient[i];
-    const double gn = g.norm();
-    if (!(gn > 0.0)) continue;
-    Vec<NC> n = Vec<NC>::Zero();
-    n.template head<D>() = g / gn;  // Σ m_p ∇N_i(x_p) points away from the body at its boundary
+    Vec<NC> n;
+    if (!contact_normal(pair, mixture_gradient, i, n)) continue;
     Vec<NC> Js, Jf;
     if (!contact_impulses<NC>(n, prescribed ? INFINITY : mb, solid.velocity[i], ms,
                               ms > 0.0 ? grains->velocity[i] : zero, mf, mf > 0.0 ? fluid->velocity[i] : zero, mu, Js,
@@ -510,7 +519,7 @@ Vec<G::ncomp> resolve_rigid_contact(ContactPair<G>& pair, RigidMotion<G>& rm, co
                                     GridField<G>* grains, GridField<G>* fluid, const std::vector<double>& weight,
                                     const double* mixture_volume, const std::vector<double>& node_volume,
                                     const Vec<G::dim>* mixture_gradient, bool across_ranks, double dt_s) {
-  constexpr int NC = G::ncomp, D = G::dim;
+  constexpr int NC = G::ncomp;
   const int nn = solid.nodes();
   const double M = rm.mass_kg;
   const Vec<NC> Vstar = rm.velocity_m_s;  // V* = V + Δt g (set by the caller)
@@ -521,13 +530,7 @@ Vec<G::ncomp> resolve_rigid_contact(ContactPair<G>& pair, RigidMotion<G>& rm, co
     if (!(ms > 0.0) && !(mf > 0.0)) return false;
     if (pair.overlap_threshold > 0.0 && pair.volume_m3[i] + mixture_volume[i] < pair.overlap_threshold * node_volume[i])
       return false;
-    Vec<D> g = pair.mass_gradient[i];
-    if (mixture_gradient) g -= mixture_gradient[i];
-    const double gn = g.norm();
-    if (!(gn > 0.0)) return false;
-    n.setZero();
-    n.template head<D>() = g / gn;
-    return true;
+    return contact_normal(pair, mixture_gradient, i, n);
   };
   // Active-set iteration for V.
   Vec<NC> V = Vstar;

@@ -201,6 +201,14 @@ class Solver {
     return static_cast<int>(contacts_.size()) - 1;
   }
   const ContactPair<G>& contact(int pair) const { return contacts_[pair]; }
+  /// The unit normal contact used at node i for the pair in the last step (contact.hpp
+  /// contact_normal); zero where it had none.
+  Vec<NC> contact_normal_at(int pair, int i) const {
+    const ContactPair<G>& c = contacts_[pair];
+    Vec<NC> n = Vec<NC>::Zero();
+    if (!contact_normal(c, c.combined_normal ? mixture_gradient_.data() : nullptr, i, n)) n.setZero();
+    return n;
+  }
   /// Declare pair `pair`'s persistent fields (mpm/fields.hpp; restored in place).
   void declare_contact_fields(int pair, FieldList& list) { contacts_[pair].declare_fields(list); }
   int contact_count() const { return static_cast<int>(contacts_.size()); }
@@ -645,17 +653,8 @@ class Solver {
   void scatter_contact_gradients() {
     if (contacts_.empty()) return;
     GridField<G>* fluid = fluid_ >= 0 ? &fields_[fluid_] : nullptr;
-    bool combined = false;
-    // Normals of free rigid bodies from the masses in the grid's plane (contact.hpp, normal_weight);
-    // the mixture's gradient is shared by the pairs: in the plane when every pair with the
-    // combined normal has a free rigid body.
-    bool plane_mix = false, other = false;
-    for (const auto& c : contacts_) {
-      combined = combined || c.combined_normal;
-      if (!c.combined_normal) continue;
-      (rigid_[c.solid].kind == BodyMotion::FreeRigid ? plane_mix : other) = true;
-    }
-    plane_mix = plane_mix && !other;
+    bool combined = false;  // (the mixture's gradient is shared by the pairs)
+    for (const auto& c : contacts_) combined = combined || c.combined_normal;
     const int mix = grains_ >= 0 ? grains_ : fluid_;
     mixture_volume_scattered_ = false;
     if (mix >= 0 && fluid && combined) {
@@ -663,18 +662,17 @@ class Solver {
       // the solids (solids_box_, part 1).
       if (solids_box_.any) {
         scatter_mass_gradient_near<G, K>(*bodies_[mix], caches_[mix], global_grid(), solids_box_.centre,
-                                         solids_box_.half, mixture_gradient_, plane_mix);
+                                         solids_box_.half, mixture_gradient_);
       } else {
         for (auto& g : mixture_gradient_) g.setZero();
       }
     } else if (mix >= 0 && (combined || !fluid)) {  // mixture mass gradient and/or volume
       scatter_mass_gradient_and_volume<G, K>(*bodies_[mix], caches_[mix], combined ? &mixture_gradient_ : nullptr,
-                                             mixture_volume_, plane_mix);
+                                             mixture_volume_);
       mixture_volume_scattered_ = true;
     }
     for (auto& c : contacts_)
-      scatter_mass_gradient_and_volume<G, K>(*bodies_[c.solid], caches_[c.solid], &c.mass_gradient, c.volume_m3,
-                                             rigid_[c.solid].kind == BodyMotion::FreeRigid);
+      scatter_mass_gradient_and_volume<G, K>(*bodies_[c.solid], caches_[c.solid], &c.mass_gradient, c.volume_m3);
   }
 
   /// Contact, part 3 (after the grid pass): every pair's impulses (model.md §8, contact.hpp),
@@ -692,6 +690,13 @@ class Solver {
     const double* mixture_volume = mixture_volume_scattered_ ? mixture_volume_.data() : nullptr;
     if (fluid) mixture_volume = fluid->volume_m3.data();
     if (halo_) timed_exchange([&] { sum_contact_arrays_to_owners(); });
+    // The gradients' images at walls and the axis (mirror planes, as the masses in phase 3).
+    bool combined = false;
+    for (auto& c : contacts_) {
+      fold_wall_gradient<D>(grid_, bc_, c.mass_gradient);
+      combined = combined || c.combined_normal;
+    }
+    if (combined) fold_wall_gradient<D>(grid_, bc_, mixture_gradient_);
     for (auto& rm : rigid_) rm.velocity_m_s = rm.predicted_m_s;
     const bool across_ranks = dec_ != nullptr;
     for (auto& c : contacts_) {
