@@ -121,6 +121,36 @@ TEST(IntrusionFronts, RecoversPropagationFactors) {
   EXPECT_NEAR(edge.intercept, 3e-3, 1e-10);
 }
 
+TEST(IntrusionFronts, ToFarthestFitsTheAdvancingPhaseOfAFrontThatRecedes) {
+  // k_l = 3, k_t = 1.5 (ratio 2) for 4 ms, then both fronts recede (lab-frame depth speed
+  // v_0 (1 + k_l) with k_l = -2, radius at k_t = -0.5 v_0) for 6 ms: the whole-run fit mixes the
+  // two phases; the fit up to the farthest extent recovers the advancing speeds exactly.
+  const double tp = 4e-3, dt = 5e-4;
+  const Synthetic run{3.0, 1.5};
+  Synthetic back{-2.0, -0.5};
+  back.ahead0 = run.ahead0 + (run.k_l - back.k_l) * 0.2 * tp;
+  back.edge0 = run.edge0 + (run.k_t - back.k_t) * 0.2 * tp;
+  std::vector<IntrusionFrame> frames;
+  for (int k = 0; k * dt <= 0.010 + 1e-12; ++k)
+    frames.push_back(k * dt <= tp + 1e-12 ? run.frame(k * dt) : back.frame(k * dt));
+  const FrontSeries series = measure_front_series(frames, velocity_front(kV0), geometry());
+  const FrontSpeeds whole = front_speeds(series, kV0);
+  EXPECT_LT(whole.k_l, 0.0);  // the receding phase dominates the whole-run fit
+  FrontFitOptions o;
+  o.to_farthest = true;
+  const FrontSpeeds adv = front_speeds(series, kV0, o);
+  EXPECT_NEAR(adv.k_l, 3.0, 1e-8);
+  EXPECT_NEAR(adv.k_t, 1.5, 1e-8);
+  EXPECT_NEAR(adv.ratio, 2.0, 1e-8);
+  EXPECT_NEAR(adv.longitudinal_t_end_s, tp, 1e-12);
+  EXPECT_NEAR(adv.transverse_t_end_s, tp, 1e-12);
+  // A front that keeps advancing is fitted whole.
+  const FrontSeries steady = measure_front_series(run.run(0.010, dt), velocity_front(kV0), geometry());
+  const FrontSpeeds all = front_speeds(steady, kV0), far = front_speeds(steady, kV0, o);
+  EXPECT_EQ(far.longitudinal.points, all.longitudinal.points);
+  EXPECT_EQ(far.k_l, all.k_l);
+}
+
 TEST(IntrusionFronts, StructureFrontUsesTheSameSearch) {
   // f in [0, 1] with the same geometry as u_z/v_0: the f >= 0.5 front is the same front.
   const Synthetic syn{1.6, 0.8};

@@ -266,12 +266,20 @@ TimeSeries fit_points(const FrontSeries& series, bool longitudinal, const FrontF
     out.value.push_back(longitudinal ? series.direction * (p.longitudinal_z_m - series.reference_z_m)
                                      : p.transverse_r_m);
   }
-  why = fmt::format("{} frames, front found in {}, {} inside [{}, {}] s{}", series.frames.size(), found, in_window,
+  std::string farthest;
+  if (o.to_farthest && !out.value.empty()) {
+    const auto k = static_cast<std::size_t>(std::max_element(out.value.begin(), out.value.end()) - out.value.begin());
+    if (k + 1 < out.size()) farthest = fmt::format(", up to its farthest extent at t = {} s", out.time[k]);
+    out.time.resize(k + 1);
+    out.value.resize(k + 1);
+  }
+  why = fmt::format("{} frames, front found in {}, {} inside [{}, {}] s{}{}", series.frames.size(), found, in_window,
                     o.t_begin_s, o.t_end_s,
                     std::isnan(cut_time) ? std::string()
                                          : fmt::format(", cut at t = {} s where the front came within {} m "
                                                        "of the wall",
-                                                       cut_time, o.wall_margin_m));
+                                                       cut_time, o.wall_margin_m),
+                    farthest);
   return out;
 }
 }  // namespace

@@ -137,6 +137,10 @@ struct FrontFitOptions {
   /// frames whose front reached the grid's end are still excluded.
   double wall_margin_m = 0.0;
   std::size_t min_points = 3;  ///< fewer points in a fit -> InputError
+  /// Fit each front only up to its farthest extent (the first frame of its largest depth below the
+  /// reference, or of its largest radius): the advancing phase of a front that later recedes.
+  /// A front that keeps advancing is fitted whole, as without it.
+  bool to_farthest = false;
 };
 
 /// Front speeds and the paper's propagation factors.

@@ -119,6 +119,15 @@ nlohmann::json IntrusionAnalysis<G>::result() const {
       j["speeds"] = nullptr;
       j["fit_note"] = e.what();
     }
+    // The advancing phase only (docs/analysis.md "Intrusion": a front that runs, then recedes).
+    analysis::FrontFitOptions far = fo;
+    far.to_farthest = true;
+    try {
+      j["speeds_to_farthest"] = analysis::to_json(analysis::front_speeds(series, std::fabs(v0), far));
+    } catch (const InputError& e) {
+      j["speeds_to_farthest"] = nullptr;
+      j["fit_note_to_farthest"] = e.what();
+    }
     return j;
   };
   nlohmann::json vel = fronts(uz_frames_, analysis::velocity_front(v0, cfg_.analysis.front_fraction));
@@ -127,6 +136,9 @@ nlohmann::json IntrusionAnalysis<G>::result() const {
   const nlohmann::json& sp = vel["speeds"];
   for (const char* k : {"v_fl", "v_ft", "k_l", "k_t", "k_l_over_k_t"})
     out[k] = sp.is_null() ? nlohmann::json(nullptr) : sp[k];
+  const nlohmann::json& spf = vel["speeds_to_farthest"];
+  for (const char* k : {"k_l", "k_t", "k_l_over_k_t"})
+    out[std::string(k) + "_to_farthest"] = spf.is_null() ? nlohmann::json(nullptr) : spf[k];
   out["v0"] = std::fabs(v0);
   out["ramp_time"] = tb.cfg->ramp_time_s;
   out["filter_window_frames"] = window;
