@@ -140,14 +140,19 @@ def fig9(run, out):
             if wall:
                 ax.plot(*zip(*wall), "x", color=col, ms=4, label=f"{lab} (at a wall)")
         sp = fd.get("speeds") or {}
-        for ax, fitkey, kkey in ((axl, "longitudinal_fit", "k_l"), (axt, "transverse_fit", "k_t")):
-            fit = sp.get(fitkey)
-            if not fit or not finite(fit.get("slope")):
-                continue
-            tt = np.linspace(fit["t_begin"], fit["t_end"], 50)
-            ax.plot(tt * 1e3, (fit["intercept"] + fit["slope"] * tt) * mm, "--", color=col, lw=1.6,
-                    label=f"fit: {fit['slope']:.3g} m/s, {kkey} = {sp.get(kkey, float('nan')):.3g}, "
-                          f"R² = {fit['r_squared']:.3f}")
+        far = fd.get("speeds_to_farthest") or {}
+        for fits, style, what in ((sp, "--", "fit"), (far, ":", "fit to the farthest extent")):
+            if what != "fit" and fits.get("longitudinal_fit") == sp.get("longitudinal_fit") and \
+                    fits.get("transverse_fit") == sp.get("transverse_fit"):
+                continue  # a front that kept advancing: the same fit
+            for ax, fitkey, kkey in ((axl, "longitudinal_fit", "k_l"), (axt, "transverse_fit", "k_t")):
+                fit = fits.get(fitkey)
+                if not fit or not finite(fit.get("slope")):
+                    continue
+                tt = np.linspace(fit["t_begin"], fit["t_end"], 50)
+                ax.plot(tt * 1e3, (fit["intercept"] + fit["slope"] * tt) * mm, style, color=col, lw=1.6,
+                        label=f"{what}: {fit['slope']:.3g} m/s, {kkey} = {fits.get(kkey, float('nan')):.3g}, "
+                              f"R² = {fit['r_squared']:.3f}")
         if finite(sp.get("k_l_over_k_t")):
             err = sp.get("k_l_over_k_t_stderr")
             notes.append(f"{lab.split(' u_z')[0]}: k_l = {sp['k_l']:.3g}, k_t = {sp['k_t']:.3g}, "

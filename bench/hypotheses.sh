@@ -1,0 +1,62 @@
+#!/bin/bash
+# The experiments of docs/results.md "Diagnosis": for one claim, runs of its scene with one change
+# at a time from the scene's defaults, each one `oobleck run` (its command is the first line of
+# OUT/<variant>_<point>/log.txt), JOBS at a time; a run whose summary.json exists is skipped.
+# Then tools/hypotheses_table.py tables the claim's own quantities into OUT/table.md.
+#   bash bench/hypotheses.sh CLAIM [BUILD=build/release] [OUT=out/hypotheses_CLAIM] [JOBS=2]
+# CLAIM: s3 (intruder fronts at phi 0.47 / v0 0.2 and phi 0.49 / v0 0.5, 1 mm, 20 ms; ~1-2 min
+# per run on one thread, the deep bed ~5 min), s1 (fast bob, 1 mm, 0.1 s; ~1 min per run),
+# s4 (fast and slow wheel, 13.3 mm, 1.5 s; 10-20 min per run).
+set -euo pipefail
+exe() { if [ -d "$1" ]; then echo "$1/oobleck"; else echo "$1"; fi; }
+CLAIM=${1:?usage: bench/hypotheses.sh s1|s3|s4 [BUILD] [OUT] [JOBS]}
+X=$(realpath -- "$(exe "${2:-build/release}")")
+OUT=${3:-out/hypotheses_$CLAIM}
+JOBS=${4:-2}
+cd "$(dirname "$0")/.."
+flip="transfer.scheme=flip transfer.flip_fraction=1.0"
+# variant | scene | --set options (space-separated); points: a name and its --set options
+case "$CLAIM" in
+  s3)
+    s=scenes/paper/intrusion.toml
+    variants=("defaults|$s|" "flip|$s|$flip" "linear|$s|grid.shape_function=linear"
+      "linear_flip|$s|grid.shape_function=linear $flip" "frictionless|$s|body.0.friction=0"
+      "K0_1|$s|K_0=1" "kappa_1e7|$s|kappa=1e7" "ramp_2ms|$s|ramp_time=0.002" "cfl_0.2|$s|time.cfl=0.2"
+      "deep_bed|scenes/paper/intrusion_deep.toml|")
+    points=("0.47_0.2|phi=0.47 v0=0.2" "0.49_0.5|phi=0.49 v0=0.5") ;;
+  s1)
+    s=scenes/paper/annular_shear.toml
+    variants=("defaults|$s|" "flip|$s|$flip" "linear|$s|grid.shape_function=linear" "cfl_0.2|$s|time.cfl=0.2"
+      "cells_2mm|$s|grid.cell_size=0.002")
+    points=("fast|") ;;
+  s4)
+    s=scenes/paper/wheel.toml
+    variants=("defaults|$s|" "linear|$s|grid.shape_function=linear" "dt_1e-5|$s|time.dt=1e-5")
+    points=("omega10|omega=10" "omega1|omega=1") ;;
+  *) echo "hypotheses: unknown claim '$CLAIM' (s1, s3 or s4)" >&2; exit 2 ;;
+esac
+mkdir -p "$OUT"
+jobs_file="$OUT/jobs.txt"
+: >"$jobs_file"
+for v in "${variants[@]}"; do
+  IFS='|' read -r name file sets <<<"$v"
+  for p in "${points[@]}"; do
+    IFS='|' read -r pname psets <<<"$p"
+    d="$OUT/${name}_${pname}"
+    [ -f "$d/summary.json" ] && continue
+    args="run $file --out $d --threads 1 --quiet"
+    for o in $psets $sets; do args+=" --set $o"; done
+    echo "$args" >>"$jobs_file"
+  done
+done
+run_one() {
+  local d
+  d=$(sed -E 's/.* --out ([^ ]+) .*/\1/' <<<"$2")
+  mkdir -p "$d"
+  echo "\$ oobleck $2" >"$d/log.txt"
+  # shellcheck disable=SC2086
+  "$1" $2 >>"$d/log.txt" 2>&1 || echo "hypotheses: failed: oobleck $2 (see $d/log.txt)" >&2
+}
+export -f run_one
+xargs -P "$JOBS" -I{} bash -c 'run_one "$0" "$1"' "$X" {} <"$jobs_file"
+/usr/bin/python3 tools/hypotheses_table.py "$CLAIM" "$OUT" | tee "$OUT/table.md"
