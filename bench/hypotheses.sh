@@ -22,7 +22,12 @@ case "$CLAIM" in
     variants=("defaults|$s|" "flip|$s|$flip" "linear|$s|grid.shape_function=linear"
       "linear_flip|$s|grid.shape_function=linear $flip" "frictionless|$s|body.0.friction=0"
       "K0_1|$s|K_0=1" "kappa_1e7|$s|kappa=1e7" "ramp_2ms|$s|ramp_time=0.002" "cfl_0.2|$s|time.cfl=0.2"
-      "deep_bed|scenes/paper/intrusion_deep.toml|")
+      "flip_cfl_0.2|$s|$flip time.cfl=0.2" "deep_bed|scenes/paper/intrusion_deep.toml|"
+      "flip_deep_bed|scenes/paper/intrusion_deep.toml|$flip")
+    # grid convergence (a 36 mm tall grid, so that 2 mm cells fit; the bed and intruder as the scene's)
+    for h in 0.002 0.001 0.0005; do
+      variants+=("h${h}|$s|grid.cell_size=$h grid.size=[0.05,0.036]" "flip_h${h}|$s|grid.cell_size=$h grid.size=[0.05,0.036] $flip")
+    done
     points=("0.47_0.2|phi=0.47 v0=0.2" "0.49_0.5|phi=0.49 v0=0.5") ;;
   s1)
     s=scenes/paper/annular_shear.toml
@@ -49,6 +54,9 @@ for v in "${variants[@]}"; do
     echo "$args" >>"$jobs_file"
   done
 done
+# the longest runs first (the finest grid, the deep bed), so that the short ones fill in beside them
+{ grep -E "cell_size=0\.0005|intrusion_deep" "$jobs_file" || true; grep -vE "cell_size=0\.0005|intrusion_deep" "$jobs_file" || true; } >"$jobs_file.sorted"
+mv "$jobs_file.sorted" "$jobs_file"
 run_one() {
   local d
   d=$(sed -E 's/.* --out ([^ ]+) .*/\1/' <<<"$2")

@@ -60,5 +60,5 @@ for w in omegas:
         rh = "" if name.startswith("plane") else f"{(h - ref['hub_height_final']) / ref['hub_height_final']:+.3f}"
         rd = "" if name.startswith("plane") else f"{(d - ref['distance']) / abs(ref['distance']):+.3f}"
         print(f"{name:<14} {s['points']:>8} {s['steps']:>6} {sum(s['timings_seconds'].values()):>8.1f} {h:>12.4f} {rh:>7} "
-              f"{a['hub_height_min']:>10.4f} {a['height_loss']:>8.4f} {d:>11.4f} {rd:>7} {str(a['stays_at_surface']):>10}")
+              f"{a['hub_height_min']:>10.4f} {a['height_loss']:>8.4f} {d:>11.4f} {rd:>7} {str(a['runs_on_surface']):>10}")
 PY

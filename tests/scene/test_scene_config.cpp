@@ -106,6 +106,12 @@ TEST(SceneConfig, ErrorsNameFileKeyAndRule) {
 
   e = error_with("", "", {"phi=1.5"});
   EXPECT_NE(e.find("region[0].phi"), std::string::npos) << e;
+  // The linear kernels' mass floor: a fraction in [0, 1], and only with linear shape functions.
+  e = error_with("", "", {"grid.linear_mass_floor=0.1"});
+  EXPECT_NE(e.find("grid.linear_mass_floor"), std::string::npos) << e;
+  EXPECT_NE(e.find("linear"), std::string::npos) << e;
+  e = error_with("", "", {"grid.shape_function=linear", "grid.linear_mass_floor=1.5"});
+  EXPECT_NE(e.find("must be in [0, 1]"), std::string::npos) << e;
 }
 
 TEST(SceneConfig, BenchmarkScenesLoadWithTheAuthorsPointCounts) {

@@ -266,26 +266,47 @@ TimeSeries fit_points(const FrontSeries& series, bool longitudinal, const FrontF
     out.value.push_back(longitudinal ? series.direction * (p.longitudinal_z_m - series.reference_z_m)
                                      : p.transverse_r_m);
   }
-  std::string farthest;
-  if (o.to_farthest && !out.value.empty()) {
-    const auto k = static_cast<std::size_t>(std::max_element(out.value.begin(), out.value.end()) - out.value.begin());
-    if (k + 1 < out.size()) farthest = fmt::format(", up to its farthest extent at t = {} s", out.time[k]);
-    out.time.resize(k + 1);
-    out.value.resize(k + 1);
-  }
-  why = fmt::format("{} frames, front found in {}, {} inside [{}, {}] s{}{}", series.frames.size(), found, in_window,
+  why = fmt::format("{} frames, front found in {}, {} inside [{}, {}] s{}", series.frames.size(), found, in_window,
                     o.t_begin_s, o.t_end_s,
                     std::isnan(cut_time) ? std::string()
                                          : fmt::format(", cut at t = {} s where the front came within {} m "
                                                        "of the wall",
-                                                       cut_time, o.wall_margin_m),
-                    farthest);
+                                                       cut_time, o.wall_margin_m));
   return out;
+}
+
+/// The time of a front's farthest extent among the frames fit_points would take: the first frame
+/// of the largest distance ahead of the tip (longitudinal) or of the largest radius (transverse);
+/// +inf without frames.
+double farthest_time(const FrontSeries& series, bool longitudinal, const FrontFitOptions& o) {
+  std::string why;
+  const TimeSeries pts = fit_points(series, longitudinal, o, why);
+  double best = -std::numeric_limits<double>::infinity(), t = std::numeric_limits<double>::infinity();
+  std::size_t k = 0;
+  for (const FrontPosition& p : series.frames) {
+    if (k == pts.size()) break;
+    if (p.time_s != pts.time[k]) continue;  // (a frame fit_points left out)
+    ++k;
+    const double extent = longitudinal ? p.longitudinal_ahead_m : p.transverse_r_m;
+    if (extent > best) {
+      best = extent;
+      t = p.time_s;
+    }
+  }
+  return t;
 }
 }  // namespace
 
-FrontSpeeds front_speeds(const FrontSeries& series, double v0_m_per_s, const FrontFitOptions& options) {
+FrontSpeeds front_speeds(const FrontSeries& series, double v0_m_per_s, const FrontFitOptions& options_in) {
   if (series.frames.empty()) throw InputError("front_speeds: empty front series");
+  FrontFitOptions options = options_in;
+  if (options.to_farthest) {
+    // Both fronts over the common advancing window: until the first of them is at its farthest.
+    options.to_farthest = false;
+    options.t_end_s =
+        std::min({options.t_end_s, farthest_time(series, true, options), farthest_time(series, false, options)});
+    if (!(options.t_begin_s <= options.t_end_s)) options.t_end_s = options.t_begin_s;
+  }
   if (!(std::isfinite(options.wall_margin_m) && options.wall_margin_m >= 0.0))
     throw InputError(fmt::format("front_speeds: wall margin = {} m must be finite and >= 0", options.wall_margin_m));
   if (!(options.t_begin_s <= options.t_end_s))

@@ -137,9 +137,9 @@ struct FrontFitOptions {
   /// frames whose front reached the grid's end are still excluded.
   double wall_margin_m = 0.0;
   std::size_t min_points = 3;  ///< fewer points in a fit -> InputError
-  /// Fit each front only up to its farthest extent (the first frame of its largest depth below the
-  /// reference, or of its largest radius): the advancing phase of a front that later recedes.
-  /// A front that keeps advancing is fitted whole, as without it.
+  /// Fit both fronts only until the first of them reaches its farthest extent (the first frame of
+  /// its largest distance ahead of the tip, or of its largest radius), the common advancing window
+  /// of fronts that later fall back; fronts that keep advancing are fitted whole, as without it.
   bool to_farthest = false;
 };
 

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -274,7 +275,8 @@ class Solver {
     for (auto& c : contacts_)
       if (rigid_[c.solid].kind == BodyMotion::FreeRigid && !c.shape.built)
         build_rigid_shape(c.shape, *bodies_[c.solid], grid_);
-    contact_weight_.clear();  // (recomputed on the local grid, owned nodes only)
+    contact_weight_.clear();      // (recomputed on the local grid, owned nodes only)
+    mass_floor_density_.clear();  // (linear kernels: recomputed over every rank's points)
     dec_ = std::make_unique<Decomposition<D>>(dec);
     grid_ = dec_->local_grid();
     for (int a = 0; a < D; ++a) {  // faces inside the domain (or across a split periodic axis) are open
@@ -304,6 +306,12 @@ class Solver {
   /// (Δt ≤ cfl h / (c + |v|_max)) and the laws' viscous limits ρ h²/(2η) (model.md §6). The
   /// drag is semi-implicit and never limits Δt.
   double stable_dt(double cfl = 0.5) const {
+    const auto [dt_wave, dt_visc] = time_step_limits(cfl);
+    return std::min(dt_wave, dt_visc);
+  }
+
+  /// stable_dt's two limits: {cfl h/(c + |v|)_max (+∞ without waves), min ρ h²/(2η) (+∞ without)}.
+  std::pair<double, double> time_step_limits(double cfl) const {
     double c_max = 0.0, dt_visc = INFINITY;
     for (const auto& b : bodies_) {
       double c = b->law ? b->law->max_wave_speed(*b) : 0.0;
@@ -316,7 +324,7 @@ class Solver {
       c_max = comm::max(c_max);
       dt_visc = comm::min(dt_visc);
     }
-    return std::min(c_max > 0.0 ? cfl * grid_.h_m / c_max : INFINITY, dt_visc);
+    return {c_max > 0.0 ? cfl * grid_.h_m / c_max : INFINITY, dt_visc};
   }
 
   /// Refuse a time step above the stable one (model.md §6): throws InputError with the numbers.

@@ -250,9 +250,10 @@ void set_time_step(const SceneConfig& cfg, BuiltScene<G>& s) {
     s.solver->options().dt_s = s.dt_s;
   }
   // Linear kernels: the nodal mass floor (SolverOptions::linear_mass_floor) (Δt/Δt_crit)², Δt_crit
-  // the stable step of a full node (CFL 1): cfl² for a step from time.cfl.
+  // the wave's stable step on a full node (CFL 1): cfl² for a step from time.cfl (a viscous limit
+  // below the wave's does not enter: it is not what a small mass shortens).
   if (s.solver->options().shape == mpm::ShapeKind::Linear) {
-    const double ratio = s.dt_s / s.solver->stable_dt(1.0);
+    const double ratio = s.dt_s / s.solver->time_step_limits(1.0).first;
     s.solver->options().linear_mass_floor = cfg.grid.linear_mass_floor.value_or(std::min(1.0, ratio * ratio));
   }
   s.total_steps = std::max(1L, static_cast<long>(std::llround(cfg.time.duration_s / s.dt_s)));

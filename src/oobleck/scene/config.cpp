@@ -233,6 +233,8 @@ GridConfig read_grid(io::TomlReader& top) {
   }
   grid.shape = parse_enum(g, "shape_function", ShapeKind::Quadratic, kShapes);
   if (g.has("linear_mass_floor")) {
+    if (grid.shape != ShapeKind::Linear)
+      g.fail("linear_mass_floor", "applies to shape_function = \"linear\" only (B-splines have no mass floor)");
     const double floor = g.number("linear_mass_floor");
     g.require(floor >= 0.0 && floor <= 1.0, "linear_mass_floor", floor,
               "must be in [0, 1] (a fraction of a full node's mass; 0: off)");
