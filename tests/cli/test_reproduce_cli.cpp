@@ -2,7 +2,6 @@
 // report.md with a verdict that is "met" or "not met" and measured numbers beside it.
 #include <gtest/gtest.h>
 
-#include <fstream>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -10,20 +9,11 @@
 
 #include "cli_runner.hpp"
 
-namespace {
-std::string read(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-}  // namespace
-
 TEST(ReproduceCli, OnlyS3RunsTheIntruderSweepAndReportsEveryClaimWithAVerdict) {
   clitest::TempDir d;
   const auto r = clitest::run("reproduce --quick --only S3 --threads 1 --out " + d / "rep");
   ASSERT_EQ(r.status, 0) << r.output;
-  const std::string md = read(d / "rep/report.md");
+  const std::string md = clitest::read_text(d / "rep/report.md");
   // Only S3's runs: no steady, verification, S1, S2 or S4 rows.
   for (const char* other : {"| S1 ", "| S2 ", "| S4 ", "| V3", "| V4"})
     EXPECT_EQ(md.find(other), std::string::npos) << other;

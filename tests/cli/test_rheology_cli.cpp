@@ -13,14 +13,7 @@
 namespace fs = std::filesystem;
 using clitest::run;
 
-namespace {
-std::string slurp(const std::string& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-}  // namespace
+using clitest::read_text;
 
 TEST(RheologyCli, FlowCurveCsvHasContractColumnsAndOrderedRows) {
   clitest::TempDir d;
@@ -72,7 +65,7 @@ TEST(RheologyCli, VolumeFractionAndStructure) {
   clitest::TempDir d;
   r = run("rheology structure --preset singh2018a --points 20 --out " + d / "f.csv");
   ASSERT_EQ(r.status, 0) << r.output;
-  EXPECT_EQ(slurp(d / "f.csv").rfind("stress,f_model,f_wyart_cates,f_singh\n", 0), 0u);
+  EXPECT_EQ(read_text(d / "f.csv").rfind("stress,f_model,f_wyart_cates,f_singh\n", 0), 0u);
 }
 
 struct BadCase {
@@ -101,7 +94,7 @@ TEST_P(BadInput, ClearMessageNonZeroExitNoOutput) {
     EXPECT_NE(r.status, 0) << args;
     EXPECT_NE(r.output.find(GetParam().message), std::string::npos) << r.output;
     if (pre_existing) {
-      EXPECT_EQ(slurp(out), "keep me\n") << "output overwritten";
+      EXPECT_EQ(read_text(out), "keep me\n") << "output overwritten";
     } else {
       EXPECT_FALSE(fs::exists(out)) << "output created";
     }

@@ -27,52 +27,13 @@
 #include "oobleck/io/checkpoint.hpp"
 
 namespace fs = std::filesystem;
+using clitest::Child;
+using clitest::read_text;
 using namespace oobleck;
 
 namespace {
 
 const std::string kSettling = std::string(OOBLECK_SOURCE_DIR) + "/scenes/verification/settling.toml";
-
-/// `oobleck run ARGS` started in the background, its output into `log`.
-class Child {
- public:
-  Child(const std::vector<std::string>& args, const std::string& log) {
-    std::vector<std::string> argv_s = {OOBLECK_CLI, "run"};
-    argv_s.insert(argv_s.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    argv.reserve(argv_s.size() + 1);
-    for (auto& a : argv_s) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&fa, 1, 2);
-    if (posix_spawn(&pid_, argv[0], &fa, nullptr, argv.data(), environ) != 0) pid_ = -1;
-    posix_spawn_file_actions_destroy(&fa);
-  }
-  ~Child() {
-    if (pid_ > 0 && !waited_) {
-      ::kill(pid_, SIGKILL);
-      wait();
-    }
-  }
-  Child(const Child&) = delete;
-  Child& operator=(const Child&) = delete;
-
-  pid_t pid() const { return pid_; }
-  void signal(int s) const { ::kill(pid_, s); }
-  /// Exit status, or 128 + the signal that ended it.
-  int wait() {
-    int st = 0;
-    ::waitpid(pid_, &st, 0);
-    waited_ = true;
-    return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
-  }
-
- private:
-  pid_t pid_ = -1;
-  bool waited_ = false;
-};
 
 /// Wait (up to 60 s) until `path` exists and holds at least `lines` lines.
 bool wait_for_lines(const std::string& path, int lines) {
@@ -84,11 +45,6 @@ bool wait_for_lines(const std::string& path, int lines) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   return false;
-}
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 nlohmann::json summary_of(const std::string& dir) { return nlohmann::json::parse(read_text(dir + "/summary.json")); }
@@ -115,7 +71,7 @@ TEST(RunFaults, SigintAndSigtermStopWithACheckpointAndRestartBitForBit) {
     const std::string out = d / ("stopped" + std::to_string(sig));
     std::vector<std::string> args = scene;
     args.insert(args.end(), {"--out", out, "--set", "output.series_interval=1e-4"});
-    Child run(args, d / "log");
+    Child run("run", args, d / "log");
     ASSERT_TRUE(wait_for_lines(out + "/series.csv", 4));
     run.signal(sig);
     EXPECT_EQ(run.wait(), 128 + sig) << read_text(d / "log");
@@ -151,7 +107,8 @@ TEST(RunFaults, SigkillAtAnyMomentLeavesARestartableCheckpointAndCompleteFrames)
   int with_checkpoint = 0;
   for (int k = 0; k < 20; ++k) {
     const std::string out = d / ("killed" + std::to_string(k));
-    Child run({kSettling, "--set", "time.duration=1.0", "--set", "output.frame_interval=1e-4", "--checkpoint-every",
+    Child run("run",
+              {kSettling, "--set", "time.duration=1.0", "--set", "output.frame_interval=1e-4", "--checkpoint-every",
                "3", "--threads", "1", "--quiet", "--out", out},
               d / "log");
     std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms(rng)));
@@ -195,7 +152,8 @@ TEST(RunFaults, FileSizeLimitIsAClearErrorAndKeepsThePreviousCheckpoint) {
 TEST(RunFaults, ASecondRunIntoAFolderInUseIsRefused) {
   clitest::TempDir d;
   const std::string out = d / "run";
-  Child first({kSettling, "--set", "time.duration=1.0", "--set", "output.series_interval=1e-4", "--threads", "1",
+  Child first("run",
+              {kSettling, "--set", "time.duration=1.0", "--set", "output.series_interval=1e-4", "--threads", "1",
                "--quiet", "--out", out},
               d / "log");
   ASSERT_TRUE(wait_for_lines(out + "/series.csv", 3));

@@ -23,6 +23,8 @@
 #include "cli_runner.hpp"
 
 namespace fs = std::filesystem;
+using clitest::Child;
+using clitest::read_text;
 
 namespace {
 
@@ -30,11 +32,6 @@ const std::string kSettling = std::string(OOBLECK_SOURCE_DIR) + "/scenes/verific
 /// Short runs: 2 ms of settling, on one thread each.
 const std::string kShort =
     " --set analysis.average_from=0.001 --set output.frame_interval=0.001 --threads 1 --set time.duration=0.002";
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 /// A CSV file (RFC 4180 quoting) as rows of cells; row 0 is the header.
 std::vector<std::vector<std::string>> read_csv(const std::string& path) {
@@ -101,44 +98,6 @@ std::size_t column(const std::vector<std::string>& header, const std::string& na
   ADD_FAILURE() << "no column " << name;
   return 0;
 }
-
-/// `oobleck sweep ARGS` started in the background, its output into `log`.
-class Child {
- public:
-  Child(const std::vector<std::string>& args, const std::string& log) {
-    std::vector<std::string> argv_s = {OOBLECK_CLI, "sweep"};
-    argv_s.insert(argv_s.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    argv.reserve(argv_s.size() + 1);
-    for (auto& a : argv_s) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&fa, 1, 2);
-    if (posix_spawn(&pid_, argv[0], &fa, nullptr, argv.data(), environ) != 0) pid_ = -1;
-    posix_spawn_file_actions_destroy(&fa);
-  }
-  ~Child() {
-    if (pid_ > 0 && !waited_) {
-      ::kill(pid_, SIGKILL);
-      wait();
-    }
-  }
-  Child(const Child&) = delete;
-  Child& operator=(const Child&) = delete;
-  void signal(int s) const { ::kill(pid_, s); }
-  int wait() {
-    int st = 0;
-    ::waitpid(pid_, &st, 0);
-    waited_ = true;
-    return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
-  }
-
- private:
-  pid_t pid_ = -1;
-  bool waited_ = false;
-};
 
 }  // namespace
 
@@ -245,7 +204,8 @@ TEST(SweepCli, ARunWithACheckpointIsContinuedAndSigintStopsTheRunsWithCheckpoint
   // SIGINT to the sweep: forwarded to the running run, which stops with a checkpoint; no new
   // run starts; sweep.csv says so; exit 130.
   const std::string out2 = d / "stopped";
-  Child sweep({kSettling, "--vary", "phi=0.2,0.3", "--set", "time.duration=1.0", "--set", "output.series_interval=1e-4",
+  Child sweep("sweep",
+              {kSettling, "--vary", "phi=0.2,0.3", "--set", "time.duration=1.0", "--set", "output.series_interval=1e-4",
                "--threads", "1", "--out", out2},
               d / "log");
   const std::string series = out2 + "/phi=0.2/series.csv";
