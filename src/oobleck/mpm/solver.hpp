@@ -206,8 +206,8 @@ class Solver {
   /// contact_normal); zero where it had none.
   Vec<NC> contact_normal_at(int pair, int i) const {
     const ContactPair<G>& c = contacts_[pair];
-    Vec<NC> n = Vec<NC>::Zero();
-    if (!contact_normal(c, c.combined_normal ? mixture_gradient_.data() : nullptr, i, n)) n.setZero();
+    Vec<NC> n = Vec<NC>::Zero();  // (left so where there is no normal)
+    contact_normal(c, c.combined_normal ? mixture_gradient_.data() : nullptr, i, n);
     return n;
   }
   /// Declare pair `pair`'s persistent fields (mpm/fields.hpp; restored in place).

@@ -463,22 +463,6 @@ void p2g_sum_share(const parallel::Team& team, GridField<G>& field, bool split_p
 
 }  // namespace detail
 
-/// Grid update (model.md §6 step 5) of the nodes [i0, i1): v_old = mv/m, v = (mv + Δt f)/m on
-/// nodes with mass, zero elsewhere.
-template <class G>
-void update_grid_velocity(GridField<G>& field, double dt_s, int i0, int i1) {
-  for (int i = i0; i < i1; ++i) {
-    const double m = field.mass_kg[i];
-    if (m > 0.0) {
-      field.velocity_old[i] = field.momentum[i] / m;
-      field.velocity[i] = (field.momentum[i] + dt_s * field.force_N[i]) / m;
-    } else {
-      field.velocity_old[i].setZero();
-      field.velocity[i].setZero();
-    }
-  }
-}
-
 /// What G2P of one body reads and writes (see make_g2p_task).
 template <class G>
 struct G2PArgs {
