@@ -4,13 +4,15 @@
 //   --kind high: (a_inf, phi_c) of E13 to plateau viscosities     (same columns)
 //   --kind dst : eta_B terms (phi_i, alpha_i) of E8 via E14        (columns phi, shear_rate_dst)
 //   --kind curves: a joint fit to whole flow curves (rheology/fit_curves.hpp; columns phi,
-//                  shear_rate, shear_stress)
+//                  shear_rate, shear_stress), or to instrument exports, one --data FILE
+//                  [--step NAME|INDEX] --phi PHI per volume fraction (io/rheometer.hpp)
 // Writes a complete parameter file (the base set with the fitted values replaced, standard errors
 // as comments) that loads with --params in every other command.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -21,6 +23,7 @@
 #include "oobleck/core/error.hpp"
 #include "oobleck/io/csv.hpp"
 #include "oobleck/io/output_file.hpp"
+#include "oobleck/io/rheometer.hpp"
 #include "oobleck/rheology/fit.hpp"
 #include "oobleck/rheology/fit_curves.hpp"
 #include "oobleck/rheology/flow_curve.hpp"
@@ -49,6 +52,7 @@ std::string sanitize(const std::string& s) {
 
 std::string unit_of(const std::string& name) {
   if (name.find("phi_i") != std::string::npos) return "[1/(Pa s)]";
+  if (name == "tau_star") return "[Pa]";
   return "[-]";
 }
 
@@ -175,9 +179,81 @@ std::string plot_fit(const rheology::FitResult& r, const Data& d, const std::str
 
 /// `--kind curves`: the joint fit of whole flow curves (rheology/fit_curves.hpp).
 struct CurvesOpts {
-  std::string data, out, parameters, residual, png;
+  std::string data, out, parameters, residual, png;  ///< data: the file(s), ", "-separated
   bool json = false;
+  std::string args;  ///< the exports' --data/--step/--phi options ("" for one CSV)
+  /// The data files' names without folders, ", "-separated.
+  std::string names() const {
+    std::string n, item;
+    for (char c : data + ",") {
+      if (c != ',') {
+        item += c;
+        continue;
+      }
+      const std::string f = fs::path(item.substr(item.find_first_not_of(' '))).filename().string();
+      n += (n.empty() ? "" : ", ") + f;
+      item.clear();
+    }
+    return n;
+  }
 };
+
+/// One volume fraction's export: --data FILE [--step NAME|INDEX] --phi PHI.
+struct Export {
+  std::string file, step;
+  double phi = 0.0;
+};
+
+/// The table of `--kind curves`: the data CSV (columns phi, shear_rate, shear_stress) or, with
+/// --phi, the exports' flow-curve rows (io::flow_curve_rows) with their phi, in the same columns.
+io::CsvTable curves_table(const std::vector<Export>& exports, const std::string& csv, bool quiet) {
+  if (exports.empty()) {
+    std::optional<InputError> csv_error;
+    try {
+      io::CsvTable t = io::read_csv(csv);
+      if (t.has_column("phi")) return t;
+    } catch (const InputError& e) {
+      csv_error = e;
+    }
+    // Not a CSV with a phi column: an instrument export is named with what it needs.
+    io::RheometerFormat format = io::RheometerFormat::csv;
+    try {
+      format = io::read_rheometer(csv).format;
+    } catch (const InputError&) {
+    }
+    if (format != io::RheometerFormat::csv) {
+      throw InputError(
+          fmt::format("{}: a {} export has no phi column: give its volume fraction after it, --data {} "
+                      "--phi PHI [--step NAME|INDEX] (one --data and --phi per volume fraction)",
+                      csv, io::to_string(format), csv));
+    }
+    if (csv_error) throw *csv_error;
+    return io::read_csv(csv);  // without phi: the missing column is named below
+  }
+  io::CsvTable t;
+  t.header = {"phi", "shear_rate", "shear_stress"};
+  for (const auto& e : exports) {
+    t.file += (t.file.empty() ? "" : ", ") + e.file;
+    const io::RheometerFile f = io::read_rheometer(e.file);
+    for (const auto& st : f.steps) {
+      if (st.find("phi") != nullptr)
+        throw InputError(
+            fmt::format("{}: has a column 'phi' and --phi = {} was given: give one of them", e.file, e.phi));
+    }
+    const io::FlowCurveRows rows = io::flow_curve_rows(f, e.step, fmt::format("--step (for {})", e.file));
+    for (std::size_t k = 0; k < rows.shear_rate.size(); ++k)
+      t.rows.push_back({e.phi, rows.shear_rate[k], rows.shear_stress[k]});
+    if (!quiet) {
+      std::vector<std::string> names;
+      for (std::size_t s : rows.steps) names.push_back(fmt::format("'{}'", f.steps[s].name));
+      fmt::print(
+          "{} ({}): phi = {}, {} points from step {}{}\n", e.file, io::to_string(f.format), e.phi,
+          rows.shear_rate.size(), fmt::join(names, ", "),
+          rows.skipped ? fmt::format(" ({} rows without both shear rate and stress skipped)", rows.skipped) : "");
+    }
+  }
+  return t;
+}
 
 /// `--kind curves --plot`: the data (with the model's value and the residual per point) and the
 /// fitted flow curves at each data phi (every branch, 300 points, cut to the data's stress range
@@ -236,8 +312,7 @@ std::string plot_curves_fit(const rheology::CurvesFitResult& r, const io::CsvTab
   return tmp;
 }
 
-void fit_curves_command(const CurvesOpts& o, rheology::Preset preset, const std::string& note) {
-  const io::CsvTable t = io::read_csv(o.data);
+void fit_curves_command(const CurvesOpts& o, const io::CsvTable& t, rheology::Preset preset, const std::string& note) {
   for (const char* c : {"phi", "shear_rate", "shear_stress"}) {
     if (!t.has_column(c)) {
       throw InputError(
@@ -266,10 +341,10 @@ void fit_curves_command(const CurvesOpts& o, rheology::Preset preset, const std:
       rheology::fit_curves(t.column("phi"), t.column("shear_rate"), t.column("shear_stress"), preset, options);
   rheology::Preset fitted = r.fitted;
   fitted.name = sanitize(fs::path(o.out).stem().string());
-  fitted.source = sanitize(fmt::format("oobleck rheology fit --kind curves to {}; base {}: {}",
-                                       fs::path(o.data).filename().string(), preset.name, preset.source));
-  std::string h = fmt::format("# oobleck parameter set fitted by: oobleck rheology fit --kind curves --data {}\n",
-                              sanitize(o.data));
+  fitted.source = sanitize(
+      fmt::format("oobleck rheology fit --kind curves to {}; base {}: {}", o.names(), preset.name, preset.source));
+  std::string h = fmt::format("# oobleck parameter set fitted by: oobleck rheology fit --kind curves {}\n",
+                              sanitize(o.args.empty() ? "--data " + o.data : o.args));
   h += fmt::format("# base set: {} ({}); every value not listed below is the base value\n", sanitize(preset.name),
                    sanitize(preset.file));
   h += fmt::format(
@@ -282,9 +357,8 @@ void fit_curves_command(const CurvesOpts& o, rheology::Preset preset, const std:
   h += fmt::format("# n = {} points, p = {} parameters, rms log residual = {:.4g}\n\n", r.n, r.p, r.rms);
   std::string tmp_png;
   if (!o.png.empty()) {
-    tmp_png = plot_curves_fit(
-        r, t, options.residual,
-        fmt::format("{}: fit --kind curves (base {})", fs::path(o.data).filename().string(), preset.name), o.png);
+    tmp_png = plot_curves_fit(r, t, options.residual,
+                              fmt::format("{}: fit --kind curves (base {})", o.names(), preset.name), o.png);
   }
   try {
     io::write_file_atomically(o.out, h + rheology::to_toml(fitted), "--out");
@@ -338,16 +412,26 @@ void add_fit_command(CLI::App& rheology) {
   struct Opts {
     ParamsOption params;
     std::string kind, data, out, png;
+    std::vector<std::string> files, steps;
+    std::vector<double> phi;
     int terms = 0;
     bool json = false;
     std::string parameters, residual = "rate";
   };
   auto o = std::make_shared<Opts>();
   cmd->add_option("--kind", o->kind, "low | high | dst | curves")->required();
-  cmd->add_option("--data", o->data,
-                  "CSV with columns phi,viscosity [Pa s] or phi,relative_viscosity (low, high); phi,shear_rate_dst "
-                  "[1/s] (dst); phi,shear_rate [1/s],shear_stress [Pa] (curves)")
-      ->required();
+  auto* data = cmd->add_option("--data", o->files,
+                               "CSV with columns phi,viscosity [Pa s] or phi,relative_viscosity (low, high); "
+                               "phi,shear_rate_dst [1/s] (dst); phi,shear_rate [1/s],shear_stress [Pa] (curves); "
+                               "curves: or an instrument export (TRIOS, RheoCompass, rSpace, CSV with units) with "
+                               "--phi, repeated once per volume fraction")
+                   ->required();
+  auto* phi = cmd->add_option("--phi", o->phi,
+                              "curves only: the volume fraction of the --data export before it (one per --data)");
+  auto* step = cmd->add_option("--step", o->steps,
+                               "curves only: the export's step, NAME (case-insensitive, TRIOS's ' - N' optional) or "
+                               "1-based INDEX; after a --data for that file, before the first --data for all "
+                               "(default: the one step with shear rate and stress)");
   o->params.add_to(cmd);
   cmd->add_option("--out", o->out, "fitted parameter file (TOML) to write")->required();
   cmd->add_option("--plot", o->png,
@@ -362,7 +446,7 @@ void add_fit_command(CLI::App& rheology) {
   auto* residual = cmd->add_option("--residual", o->residual,
                                    "curves only: rate (ln shear rate at the measured stress) or stress (ln shear "
                                    "stress at the measured rate)");
-  cmd->callback([o, terms, parameters, residual] {
+  cmd->callback([o, cmd, data, phi, step, terms, parameters, residual] {
     if (o->kind != "low" && o->kind != "high" && o->kind != "dst" && o->kind != "curves") {
       throw InputError(
           fmt::format("--kind = '{}': must be one of low (a_0, phi_j from minimum viscosities, E12), high (a_inf, "
@@ -370,8 +454,41 @@ void add_fit_command(CLI::App& rheology) {
                       "fit to whole flow curves: phi, shear_rate, shear_stress)",
                       o->kind));
     }
+    if (o->kind != "curves") {
+      for (auto* opt : {phi, step}) {
+        if (opt->count() > 0)
+          throw InputError(
+              fmt::format("{}: only for --kind curves with instrument exports (not {})", opt->get_name(), o->kind));
+      }
+      if (o->files.size() != 1)
+        throw InputError(fmt::format("--data given {} times: --kind {} reads one CSV", o->files.size(), o->kind));
+    }
+    o->data = fmt::format("{}", fmt::join(o->files, ", "));
     if (o->kind == "curves") {
       if (terms->count() > 0) throw InputError(fmt::format("--terms = {}: only for --kind dst (not curves)", o->terms));
+      // --data FILE [--step S] --phi PHI per volume fraction: a --step belongs to the --data before it.
+      std::vector<Export> exports;
+      std::string args;
+      if (!o->phi.empty() || o->files.size() > 1 || step->count() > 0) {
+        if (o->phi.size() != o->files.size())
+          throw InputError(
+              fmt::format("--data given {} times and --phi {} times: give one --phi (the volume fraction) "
+                          "per --data export, e.g. --data a.txt --phi 0.40 --data b.txt --phi 0.44",
+                          o->files.size(), o->phi.size()));
+        std::string every;
+        std::vector<std::string> of_file(o->files.size());
+        std::size_t k = 0, j = 0;
+        for (const CLI::Option* opt : cmd->parse_order()) {
+          if (opt == data) ++k;
+          if (opt == step && j < o->steps.size()) (k == 0 ? every : of_file[k - 1]) = o->steps[j++];
+        }
+        for (std::size_t i = 0; i < o->files.size(); ++i) {
+          exports.push_back({o->files[i], of_file[i].empty() ? every : of_file[i], o->phi[i]});
+          args += fmt::format("{}--data {}{} --phi {}", i ? " " : "", o->files[i],
+                              exports.back().step.empty() ? "" : fmt::format(" --step '{}'", exports.back().step),
+                              o->phi[i]);
+        }
+      }
       const bool default_base = o->params.preset.empty() && o->params.params.empty();
       std::string note;
       if (default_base) {
@@ -379,8 +496,9 @@ void add_fit_command(CLI::App& rheology) {
             fmt::format("no --preset or --params given: using the {} preset as the base parameter set", kDefaultPreset);
         fmt::print(o->json ? stderr : stdout, "{}\n", note);
       }
-      fit_curves_command({o->data, o->out, o->parameters, o->residual, o->png, o->json}, o->params.load(kDefaultPreset),
-                         note);
+      const rheology::Preset base = o->params.load(kDefaultPreset);
+      const io::CsvTable table = curves_table(exports, o->data, o->json);
+      fit_curves_command({o->data, o->out, o->parameters, o->residual, o->png, o->json, args}, table, base, note);
       return;
     }
     for (auto* opt : {parameters, residual}) {

@@ -1,15 +1,19 @@
 // `oobleck rheology ...`: steady rheology of the model (model.md §2): flow curves with every
-// branch, the DST shear rate, the f(tau) comparison and the mass-to-volume fraction conversion.
+// branch, the DST shear rate, the f(tau) comparison, the mass-to-volume fraction conversion, and
+// `import`: a rheometer's export file as one CSV in SI (io/rheometer.hpp).
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
 #include "oobleck/core/error.hpp"
 #include "oobleck/io/output_file.hpp"
+#include "oobleck/io/rheometer.hpp"
 #include "oobleck/rheology/flow_curve.hpp"
 #include "oobleck/rheology/structure_evolution.hpp"
 #include "oobleck/rheology/volume_fraction.hpp"
@@ -169,6 +173,72 @@ void volume_fraction_command(CLI::App& rheology) {
   });
 }
 
+/// One CSV field: quoted when it holds the separator, a quote, or spaces at its ends.
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos && (s.empty() || (s.front() != ' ' && s.back() != ' '))) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+void import_command(CLI::App& rheology) {
+  auto* cmd = rheology.add_subcommand(
+      "import", "a rheometer's export (TA TRIOS .txt, Anton Paar RheoCompass, Malvern rSpace, CSV) as one CSV in SI");
+  struct Opts {
+    std::string file, out, step, format = "auto";
+  };
+  auto o = std::make_shared<Opts>();
+  cmd->add_option("file", o->file, "the export file")->required();
+  cmd->add_option("--out", o->out,
+                  "CSV to write: step, step_name, time [s], shear_rate [1/s], shear_stress [Pa], viscosity [Pa s], "
+                  "then the file's other columns (normalized names, SI)")
+      ->required();
+  cmd->add_option("--step", o->step,
+                  "only this step: NAME (case-insensitive, TRIOS's ' - N' optional) or 1-based INDEX (default: all)");
+  cmd->add_option("--format", o->format, "auto (from the content) | trios | rheocompass | rspace | csv")
+      ->capture_default_str();
+  cmd->callback([o] {
+    const io::RheometerFormat format = io::parse_rheometer_format(o->format, "--format");
+    io::check_writable(o->out, "--out");
+    const io::RheometerFile f = io::read_rheometer(o->file, format);
+    std::vector<std::size_t> steps;
+    if (!o->step.empty()) steps = io::select_steps(f, o->step, "--step");
+    const io::RheometerTable t = io::to_table(f, steps);
+    io::OutputFile csv(o->out, "--out");
+    auto& s = csv.stream();
+    std::vector<std::string> names, units;
+    for (const auto& c : t.columns) {
+      names.push_back(csv_field(c.name));
+      if (!c.si_unit.empty()) units.push_back(fmt::format("{}={}", c.name, c.si_unit));
+    }
+    s << fmt::format("# units: {}; read from {} ({})\n", fmt::join(units, ", "), o->file, io::to_string(f.format));
+    s << fmt::format("{}\n", fmt::join(names, ","));
+    for (std::size_t r = 0; r < t.rows; ++r) {
+      std::string line;
+      for (std::size_t j = 0; j < t.columns.size(); ++j) {
+        const auto& c = t.columns[j];
+        if (j) line += ',';
+        if (c.is_text) {
+          line += csv_field(c.text[r]);
+        } else if (!std::isnan(c.values[r])) {
+          line += fmt::format("{}", c.values[r]);  // the shortest text that reads back the same
+        }
+      }
+      s << line << '\n';
+    }
+    csv.commit();
+    std::vector<std::string> step_names;
+    for (std::size_t k = 0; k < f.steps.size(); ++k) {
+      const auto& st = f.steps[k];
+      if (steps.empty() || std::find(steps.begin(), steps.end(), k) != steps.end())
+        step_names.push_back(fmt::format("{} '{}' ({} rows)", st.index, st.name, st.rows()));
+    }
+    fmt::print("read {} ({}, {}): steps {}\n", o->file, io::to_string(f.format), f.encoding,
+               fmt::join(step_names, ", "));
+    fmt::print("wrote {} ({} rows x {} columns, SI)\n", o->out, t.rows, t.columns.size());
+  });
+}
+
 }  // namespace
 
 void add_rheology_commands(CLI::App& app) {
@@ -179,6 +249,7 @@ void add_rheology_commands(CLI::App& app) {
   structure_command(*rheology);
   volume_fraction_command(*rheology);
   add_fit_command(*rheology);
+  import_command(*rheology);
 }
 
 }  // namespace oobleck::cli

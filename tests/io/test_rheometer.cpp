@@ -20,8 +20,8 @@
 namespace oobleck::io {
 namespace {
 
-using ::testing::HasSubstr;
 using test::TempDir;
+using ::testing::HasSubstr;
 
 const std::string kDir = std::string(OOBLECK_SOURCE_DIR) + "/tests/rheology/data/rheometer/";
 constexpr double kPrinted = 5e-5;  // half a unit in the 5th significant digit, relative
@@ -53,7 +53,7 @@ std::vector<TruthRow> truth() {
 }
 
 std::string write(const TempDir& dir, const std::string& name, const std::string& content) {
-  const std::string path = dir.file(name);
+  std::string path = dir.file(name);
   std::ofstream(path, std::ios::binary) << content;
   return path;
 }
@@ -120,8 +120,8 @@ TEST_P(RoundTrip, ReadsBackTheValuesTheFixtureWasWrittenFromWithinItsPrintedPrec
 
 INSTANTIATE_TEST_SUITE_P(Fixtures, RoundTrip,
                          ::testing::Values(Case{"trios_phi040.txt", RheometerFormat::trios, "UTF-8", '\t', '.'},
-                                           Case{"rheocompass_phi044.csv", RheometerFormat::rheocompass, "UTF-16LE",
-                                                ';', ','},
+                                           Case{"rheocompass_phi044.csv", RheometerFormat::rheocompass, "UTF-16LE", ';',
+                                                ','},
                                            Case{"rspace_phi046.csv", RheometerFormat::rspace, "UTF-8", ';', ','},
                                            Case{"generic_phi048.csv", RheometerFormat::csv, "UTF-8", ',', '.'}),
                          [](const auto& test_info) {
@@ -225,7 +225,8 @@ TEST(Rheometer, TableHasTheCoreColumnsFirstAndEveryOtherColumnOnce) {
 TEST(Rheometer, GenericCsvDetectsSeparatorDecimalCommaAndUnitSpellings) {
   TempDir dir;
   const auto p = write(dir, "semi.csv",
-                       "Shear rate (1/s);Shear stress [Pa];Viscosity [mPas];Temperature [\xc2\xb0" "C]\n"
+                       "Shear rate (1/s);Shear stress [Pa];Viscosity [mPas];Temperature [\xc2\xb0"
+                       "C]\n"
                        "0,5;1,25;2500;20,5\n"
                        "1,0E+001;2,5e1;2500;20,5\n");
   const RheometerFile f = read_rheometer(p);
@@ -240,7 +241,9 @@ TEST(Rheometer, GenericCsvDetectsSeparatorDecimalCommaAndUnitSpellings) {
   EXPECT_EQ(g.separator, '\t');
   EXPECT_DOUBLE_EQ(g.steps[0].find("shear_stress")->values[0], 3.0);
   // Latin-1 (no valid UTF-8): the degree sign of °C.
-  const auto latin = write(dir, "latin.csv", "shear_rate [1/s],T [\xb0" "C]\n1,20\n");
+  const auto latin = write(dir, "latin.csv",
+                           "shear_rate [1/s],T [\xb0"
+                           "C]\n1,20\n");
   const RheometerFile l = read_rheometer(latin);
   EXPECT_EQ(l.encoding, "WINDOWS-1252");
   EXPECT_EQ(l.steps[0].find("t")->unit, "\u00b0C");
@@ -262,9 +265,9 @@ TEST(Rheometer, BadInputNamesFileLineAndWhatWasExpected) {
     const auto p = write(dir, name, content);
     return error_of([&] { (void)read_rheometer(p, fmt); });
   };
-  EXPECT_THAT(err("unit.csv", "shear_rate [1/s];viscosity [mPa-s]\n1;2\n"),
-              AllOf(HasSubstr("unit.csv:1: column 'viscosity': unknown unit 'mPa-s'; expected one of"),
-                    HasSubstr("mPa s")));
+  EXPECT_THAT(
+      err("unit.csv", "shear_rate [1/s];viscosity [mPa-s]\n1;2\n"),
+      AllOf(HasSubstr("unit.csv:1: column 'viscosity': unknown unit 'mPa-s'; expected one of"), HasSubstr("mPa s")));
   EXPECT_THAT(err("kind.csv", "shear_rate [Pa],shear_stress [Pa]\n1,2\n"),
               HasSubstr("kind.csv:1: column 'shear_rate' is shear_rate but its unit 'Pa' is not one of 1/s"));
   EXPECT_THAT(err("num.csv", "shear_rate [1/s],shear_stress [Pa]\n1,2\n3,abc\n"),

@@ -51,6 +51,7 @@ bool starts_with_ci(const std::string& s, std::string_view prefix) {
 /// `bytes` converted from `from` to UTF-8 by iconv; nullopt when they are not valid in `from`.
 std::optional<std::string> iconv_to_utf8(const std::string& bytes, const char* from) {
   iconv_t cd = ::iconv_open("UTF-8", from);
+  // NOLINTNEXTLINE(performance-no-int-to-ptr): iconv_open's error value is (iconv_t)-1
   if (cd == reinterpret_cast<iconv_t>(-1)) return std::nullopt;
   std::string out(bytes.size() * 2 + 16, '\0');
   std::string in = bytes;
@@ -116,7 +117,8 @@ Text read_text(const std::string& path) {
       utf8 = iconv_to_utf8(bytes, "ISO-8859-1");
     }
   }
-  if (!utf8) throw InputError(fmt::format("{}: not valid {} text (expected a text export of a rheometer)", path, t.encoding));
+  if (!utf8)
+    throw InputError(fmt::format("{}: not valid {} text (expected a text export of a rheometer)", path, t.encoding));
   if (utf8->find('\0') != std::string::npos)
     throw InputError(fmt::format("{}: contains NUL characters (expected a text export of a rheometer)", path));
   std::string line;
@@ -212,30 +214,63 @@ std::string canonical_unit(const std::string& u) {
 }
 
 std::optional<Unit> lookup_unit(const std::string& unit) {
-  static const std::map<std::string, Unit> table = {
-      // dimensionless
-      {"", {"1", 1.0}}, {"1", {"1", 1.0}}, {"-", {"1", 1.0}}, {"%", {"1", 1e-2}},
-      // viscosity
-      {"Pa.s", {"Pa s", 1.0}}, {"mPa.s", {"Pa s", 1e-3}}, {"kPa.s", {"Pa s", 1e3}}, {"cP", {"Pa s", 1e-3}},
-      {"P", {"Pa s", 0.1}},
-      // stress, modulus
-      {"Pa", {"Pa", 1.0}}, {"mPa", {"Pa", 1e-3}}, {"kPa", {"Pa", 1e3}}, {"MPa", {"Pa", 1e6}},
-      // shear rate, frequency
-      {"1/s", {"1/s", 1.0}}, {"s-1", {"1/s", 1.0}}, {"/s", {"1/s", 1.0}}, {"Hz", {"Hz", 1.0}},
-      {"rad/s", {"rad/s", 1.0}}, {"rpm", {"rad/s", 2.0 * std::numbers::pi / 60.0}}, {"1/min", {"1/s", 1.0 / 60.0}},
-      // time
-      {"s", {"s", 1.0}}, {"ms", {"s", 1e-3}}, {"min", {"s", 60.0}}, {"h", {"s", 3600.0}},
-      // torque, force
-      {"N.m", {"N m", 1.0}}, {"mN.m", {"N m", 1e-3}}, {"uN.m", {"N m", 1e-6}}, {"nN.m", {"N m", 1e-9}},
-      {"N", {"N", 1.0}}, {"mN", {"N", 1e-3}},
-      // length, speed, angle
-      {"m", {"m", 1.0}}, {"cm", {"m", 1e-2}}, {"mm", {"m", 1e-3}}, {"um", {"m", 1e-6}}, {"m/s", {"m/s", 1.0}},
-      {"mm/s", {"m/s", 1e-3}}, {"rad", {"rad", 1.0}}, {"mrad", {"rad", 1e-3}}, {"urad", {"rad", 1e-6}},
-      {"\u00B0", {"rad", std::numbers::pi / 180.0}}, {"deg", {"rad", std::numbers::pi / 180.0}},
-      // temperature: kept as read
-      {"\u00B0C", {"\u00B0C", 1.0}}, {"C", {"\u00B0C", 1.0}}, {"K", {"K", 1.0}},
-      // power, energy
-      {"W", {"W", 1.0}}, {"mW", {"W", 1e-3}}, {"J", {"J", 1.0}}, {"mJ", {"J", 1e-3}}};
+  static const std::map<std::string, Unit> table = {// dimensionless
+                                                    {"", {"", 1.0}},
+                                                    {"1", {"1", 1.0}},
+                                                    {"-", {"1", 1.0}},
+                                                    {"%", {"1", 1e-2}},
+                                                    // viscosity
+                                                    {"Pa.s", {"Pa s", 1.0}},
+                                                    {"mPa.s", {"Pa s", 1e-3}},
+                                                    {"kPa.s", {"Pa s", 1e3}},
+                                                    {"cP", {"Pa s", 1e-3}},
+                                                    {"P", {"Pa s", 0.1}},
+                                                    // stress, modulus
+                                                    {"Pa", {"Pa", 1.0}},
+                                                    {"mPa", {"Pa", 1e-3}},
+                                                    {"kPa", {"Pa", 1e3}},
+                                                    {"MPa", {"Pa", 1e6}},
+                                                    // shear rate, frequency
+                                                    {"1/s", {"1/s", 1.0}},
+                                                    {"s-1", {"1/s", 1.0}},
+                                                    {"/s", {"1/s", 1.0}},
+                                                    {"Hz", {"Hz", 1.0}},
+                                                    {"rad/s", {"rad/s", 1.0}},
+                                                    {"rpm", {"rad/s", 2.0 * std::numbers::pi / 60.0}},
+                                                    {"1/min", {"1/s", 1.0 / 60.0}},
+                                                    // time
+                                                    {"s", {"s", 1.0}},
+                                                    {"ms", {"s", 1e-3}},
+                                                    {"min", {"s", 60.0}},
+                                                    {"h", {"s", 3600.0}},
+                                                    // torque, force
+                                                    {"N.m", {"N m", 1.0}},
+                                                    {"mN.m", {"N m", 1e-3}},
+                                                    {"uN.m", {"N m", 1e-6}},
+                                                    {"nN.m", {"N m", 1e-9}},
+                                                    {"N", {"N", 1.0}},
+                                                    {"mN", {"N", 1e-3}},
+                                                    // length, speed, angle
+                                                    {"m", {"m", 1.0}},
+                                                    {"cm", {"m", 1e-2}},
+                                                    {"mm", {"m", 1e-3}},
+                                                    {"um", {"m", 1e-6}},
+                                                    {"m/s", {"m/s", 1.0}},
+                                                    {"mm/s", {"m/s", 1e-3}},
+                                                    {"rad", {"rad", 1.0}},
+                                                    {"mrad", {"rad", 1e-3}},
+                                                    {"urad", {"rad", 1e-6}},
+                                                    {"\u00B0", {"rad", std::numbers::pi / 180.0}},
+                                                    {"deg", {"rad", std::numbers::pi / 180.0}},
+                                                    // temperature: kept as read
+                                                    {"\u00B0C", {"\u00B0C", 1.0}},
+                                                    {"C", {"\u00B0C", 1.0}},
+                                                    {"K", {"K", 1.0}},
+                                                    // power, energy
+                                                    {"W", {"W", 1.0}},
+                                                    {"mW", {"W", 1e-3}},
+                                                    {"J", {"J", 1.0}},
+                                                    {"mJ", {"J", 1e-3}}};
   const auto it = table.find(canonical_unit(unit));
   if (it == table.end()) return std::nullopt;
   return it->second;
@@ -259,9 +294,9 @@ std::string normalize_name(const std::string& header) {
   }
   while (!s.empty() && s.back() == '_') s.pop_back();
   static const std::map<std::string, std::string> aliases = {
-      {"stress", "shear_stress"},     {"shear_viscosity", "viscosity"}, {"time_sequence", "time"},
-      {"time_action", "step_time"},   {"interval_time", "step_time"},   {"point_no", "point"},
-      {"shear_strain", "strain"},     {"point_number", "point"},        {"total_time", "time"},
+      {"stress", "shear_stress"},   {"shear_viscosity", "viscosity"}, {"time_sequence", "time"},
+      {"time_action", "step_time"}, {"interval_time", "step_time"},   {"point_no", "point"},
+      {"shear_strain", "strain"},   {"point_number", "point"},        {"total_time", "time"},
   };
   const auto it = aliases.find(s);
   return it == aliases.end() ? s : it->second;
@@ -291,6 +326,7 @@ std::pair<std::string, std::string> split_unit(const std::string& field) {
 // ---- raw steps -------------------------------------------------------------------------------
 
 struct RawStep {
+  int index = 0;  ///< the file's own step number where it has one (generic CSV's step column), else 0
   std::string name;
   int line = 0;
   std::vector<std::string> headers, units;
@@ -317,7 +353,7 @@ struct Reader {
 
 RheometerStep Reader::convert(const RawStep& raw, int index) const {
   RheometerStep step;
-  step.index = index;
+  step.index = raw.index > 0 ? raw.index : index;
   step.name = raw.name;
   step.line = raw.line;
   step.lines = raw.lines;
@@ -330,8 +366,8 @@ RheometerStep Reader::convert(const RawStep& raw, int index) const {
     const int uline = j < raw.unit_lines.size() ? raw.unit_lines[j] : raw.line;
     c.name = normalize_name(c.header);
     if (c.name.empty()) {
-      if (c.header.empty() && std::all_of(raw.rows.begin(), raw.rows.end(),
-                                          [&](const auto& r) { return j >= r.size() || r[j].empty(); }))
+      if (c.header.empty() &&
+          std::all_of(raw.rows.begin(), raw.rows.end(), [&](const auto& r) { return j >= r.size() || r[j].empty(); }))
         continue;  // an unnamed, empty column (a trailing separator)
       c.name = fmt::format("column_{}", j + 1);
     }
@@ -466,13 +502,13 @@ void read_trios(Reader& r) {
         if (!value.empty()) value += ' ';
         value += fields[j];
       }
-      r.out.attributes[section.empty() ? last_key : section + "/" + last_key] = value;
+      r.out.attributes[section.empty() ? last_key : fmt::format("{}/{}", section, last_key)] = value;
     }
     ++k;
   }
-  static const std::map<std::string, std::string> named = {{"Sample name", "sample"},   {"Geometry name", "geometry"},
-                                                           {"Instrument name", "instrument"}, {"Operator", "operator"},
-                                                           {"rundate", "date"},          {"Procedure name", "procedure"}};
+  static const std::map<std::string, std::string> named = {
+      {"Sample name", "sample"}, {"Geometry name", "geometry"}, {"Instrument name", "instrument"},
+      {"Operator", "operator"},  {"rundate", "date"},           {"Procedure name", "procedure"}};
   for (const auto& [key, name] : named) {
     const auto it = r.out.attributes.find(key);
     if (it != r.out.attributes.end()) {
@@ -480,18 +516,20 @@ void read_trios(Reader& r) {
       r.out.attributes.erase(it);
     }
   }
-  if (!procedure_steps.empty()) r.out.attributes["procedure_steps"] = fmt::format("{}", fmt::join(procedure_steps, "#"));
+  if (!procedure_steps.empty())
+    r.out.attributes["procedure_steps"] = fmt::format("{}", fmt::join(procedure_steps, "#"));
   if (r.steps.empty())
-    throw InputError(fmt::format("{}: no [step] section: expected a TA TRIOS 'Export to LIMS' file with [step] "
-                                 "sections (name, column names, units, data rows)",
-                                 r.path));
+    throw InputError(
+        fmt::format("{}: no [step] section: expected a TA TRIOS 'Export to LIMS' file with [step] "
+                    "sections (name, column names, units, data rows)",
+                    r.path));
 }
 
 // ---- Anton Paar RheoCompass -------------------------------------------------------------------
 
 const std::vector<std::string>& rheocompass_labels() {
-  static const std::vector<std::string> labels = {"Project:", "Test:", "Result:", "Interval and data points:",
-                                                  "Interval data:"};
+  static const std::vector<std::string> labels = {
+      "Project:", "Test:", "Result:", "Interval and data points:", "Interval data:"};
   return labels;
 }
 
@@ -521,9 +559,10 @@ void read_rheocompass(Reader& r) {
   char sep = 0;
   for (std::size_t k = 0; k < n && sep == 0; ++k) sep = rheocompass_separator(r.line(k));
   if (sep == 0)
-    throw InputError(fmt::format("{}: no 'Project:', 'Test:', 'Result:' or 'Interval data:' line followed by a TAB, "
-                                 "';' or ',': expected an Anton Paar RheoCompass export",
-                                 r.path));
+    throw InputError(
+        fmt::format("{}: no 'Project:', 'Test:', 'Result:' or 'Interval data:' line followed by a TAB, "
+                    "';' or ',': expected an Anton Paar RheoCompass export",
+                    r.path));
   r.out.separator = sep;
   r.out.decimal = detect_decimal(r.text.lines, 0, sep);
   std::string result, interval;
@@ -564,8 +603,8 @@ void read_rheocompass(Reader& r) {
       while (ku < n && all_empty(split(r.line(ku), sep))) ++ku;
       const auto units = ku < n ? split(r.line(ku), sep) : std::vector<std::string>{};
       const bool units_ok = ku < n && !units.empty() && std::all_of(units.begin() + 1, units.end(), [](const auto& u) {
-        return u.empty() || (u.front() == '[' && u.back() == ']');
-      });
+                              return u.empty() || (u.front() == '[' && u.back() == ']');
+                            });
       if (!units_ok)
         r.fail(r.lineno(std::min(ku, n - 1)),
                fmt::format("interval '{}': expected the line of units in brackets ([s], [1/s], [Pa], ...) after the "
@@ -599,9 +638,10 @@ void read_rheocompass(Reader& r) {
     ++k;
   }
   if (r.steps.empty())
-    throw InputError(fmt::format("{}: no 'Interval data:' line: expected an Anton Paar RheoCompass export with at "
-                                 "least one interval (names, units, data rows)",
-                                 r.path));
+    throw InputError(
+        fmt::format("{}: no 'Interval data:' line: expected an Anton Paar RheoCompass export with at "
+                    "least one interval (names, units, data rows)",
+                    r.path));
 }
 
 // ---- Malvern rSpace --------------------------------------------------------------------------
@@ -627,8 +667,8 @@ void read_rspace(Reader& r) {
   const auto first = first_content_line(r.text);
   const char sep = first ? rspace_separator(r.line(*first)) : 0;
   if (sep == 0)
-    throw InputError(fmt::format("{}:{}: expected the rSpace header 'Action Name;Name(unit);...'", r.path,
-                                 first ? *first + 1 : 1));
+    throw InputError(
+        fmt::format("{}:{}: expected the rSpace header 'Action Name;Name(unit);...'", r.path, first ? *first + 1 : 1));
   r.out.separator = sep;
   r.out.decimal = detect_decimal(r.text.lines, *first + 1, sep);
   const auto header = split(r.line(*first), sep);
@@ -700,7 +740,8 @@ void read_generic(Reader& r) {
   }
   for (std::size_t j = 0; j < names.size(); ++j) {
     if (names[j].empty())
-      r.fail(r.lineno(*header_line), fmt::format("column {}: empty name in the header (expected a name for every column)", j + 1));
+      r.fail(r.lineno(*header_line),
+             fmt::format("column {}: empty name in the header (expected a name for every column)", j + 1));
     if (parse_number(names[j], r.out.decimal))
       r.fail(r.lineno(*header_line), fmt::format("'{}' is a number: expected a header row of column names", names[j]));
   }
@@ -743,10 +784,15 @@ void read_generic(Reader& r) {
       st.units = col_units;
       st.unit_lines.assign(col_names.size(), r.lineno(*header_line));
       st.units_required = false;
+      if (j_step) {
+        const auto v = parse_number(fields[*j_step], r.out.decimal);
+        if (v && *v >= 1.0 && *v < 1e6 && *v == std::floor(*v)) st.index = static_cast<int>(*v);
+      }
       r.steps.push_back(std::move(st));
       last_key = key;
     }
     std::vector<std::string> row;
+    row.reserve(keep.size());
     for (std::size_t j : keep) row.push_back(fields[j]);
     r.steps.back().rows.push_back(std::move(row));
     r.steps.back().lines.push_back(r.lineno(k));
@@ -838,18 +884,10 @@ RheometerFile read_rheometer(const std::string& path, RheometerFormat format) {
   r.out.encoding = text.encoding;
   r.out.format = format == RheometerFormat::automatic ? detect(text) : format;
   switch (r.out.format) {
-    case RheometerFormat::trios:
-      read_trios(r);
-      break;
-    case RheometerFormat::rheocompass:
-      read_rheocompass(r);
-      break;
-    case RheometerFormat::rspace:
-      read_rspace(r);
-      break;
-    default:
-      read_generic(r);
-      break;
+    case RheometerFormat::trios: read_trios(r); break;
+    case RheometerFormat::rheocompass: read_rheocompass(r); break;
+    case RheometerFormat::rspace: read_rspace(r); break;
+    default: read_generic(r); break;
   }
   int index = 0;
   std::size_t rows = 0;
@@ -865,11 +903,16 @@ RheometerFile read_rheometer(const std::string& path, RheometerFormat format) {
 
 std::vector<std::size_t> select_steps(const RheometerFile& f, const std::string& spec, const std::string& option) {
   const std::string s = trim(spec);
-  if (!s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); })) {
-    const auto k = std::stoul(s.size() > 9 ? std::string("0") : s);
-    if (k < 1 || k > f.steps.size())
-      throw InputError(fmt::format("{} = {}: {} has steps 1 to {} ({})", option, s, f.file, f.steps.size(), list_steps(f)));
-    return {k - 1};
+  if (!s.empty() &&
+      std::all_of(s.begin(), s.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); })) {
+    const int k = s.size() > 9 ? 0 : std::stoi(s);
+    std::vector<std::size_t> out;
+    for (std::size_t i = 0; i < f.steps.size(); ++i) {
+      if (f.steps[i].index == k) out.push_back(i);
+    }
+    if (out.empty())
+      throw InputError(fmt::format("{} = {}: {} has no step {} (steps: {})", option, s, f.file, s, list_steps(f)));
+    return out;
   }
   std::vector<std::size_t> out;
   for (std::size_t k = 0; k < f.steps.size(); ++k) {
@@ -887,10 +930,10 @@ std::vector<std::size_t> select_steps(const RheometerFile& f, const std::string&
     for (const auto& st : f.steps) {
       if (!near_key.empty() && near.empty() && step_key(st.name) == near_key) near = st.name;
     }
-    throw InputError(fmt::format("{} = '{}': no such step in {}{} (steps: {}); give a name (case-insensitive, the "
-                                 "' - N' suffix optional) or an index",
-                                 option, spec, f.file, near.empty() ? "" : fmt::format("; did you mean '{}'?", near),
-                                 list_steps(f)));
+    throw InputError(fmt::format(
+        "{} = '{}': no such step in {}{} (steps: {}); give a name (case-insensitive, the "
+        "' - N' suffix optional) or an index",
+        option, spec, f.file, near.empty() ? "" : fmt::format("; did you mean '{}'?", near), list_steps(f)));
   }
   return out;
 }
@@ -975,14 +1018,16 @@ FlowCurveRows flow_curve_rows(const RheometerFile& f, const std::string& step_sp
       }
     }
     if (steps.empty())
-      throw InputError(fmt::format("{}: no step has values of both shear rate and shear stress (steps: {}); a "
-                                   "flow curve needs both",
-                                   f.file, list_steps(f)));
+      throw InputError(
+          fmt::format("{}: no step has values of both shear rate and shear stress (steps: {}); a "
+                      "flow curve needs both",
+                      f.file, list_steps(f)));
     if (steps.size() > 1) {
       std::vector<std::string> names;
+      names.reserve(steps.size());
       for (std::size_t k : steps) names.push_back(fmt::format("{} '{}'", f.steps[k].index, f.steps[k].name));
-      throw InputError(fmt::format("{}: {} steps hold shear rate and stress ({}): choose with {} NAME or INDEX",
-                                   f.file, steps.size(), fmt::join(names, ", "), option));
+      throw InputError(fmt::format("{}: {} steps hold shear rate and stress ({}): choose with {} NAME or INDEX", f.file,
+                                   steps.size(), fmt::join(names, ", "), option));
     }
   }
   FlowCurveRows out;
@@ -992,15 +1037,17 @@ FlowCurveRows flow_curve_rows(const RheometerFile& f, const std::string& step_sp
     const auto* rate = st.find("shear_rate");
     const auto* stress = st.find("shear_stress");
     if (!rate || !stress || rate->is_text || stress->is_text)
-      throw InputError(fmt::format("{}: step '{}' (line {}) has no {} column (columns: {}); a flow curve needs "
-                                   "shear rate and shear stress",
-                                   f.file, st.name, st.line, rate ? "shear stress" : "shear rate",
-                                   fmt::join([&] {
-                                     std::vector<std::string> h;
-                                     for (const auto& c : st.columns) h.push_back(c.header);
-                                     return h;
-                                   }(),
-                                             ", ")));
+      throw InputError(
+          fmt::format("{}: step '{}' (line {}) has no {} column (columns: {}); a flow curve needs "
+                      "shear rate and shear stress",
+                      f.file, st.name, st.line, rate ? "shear stress" : "shear rate",
+                      fmt::join(
+                          [&] {
+                            std::vector<std::string> h;
+                            for (const auto& c : st.columns) h.push_back(c.header);
+                            return h;
+                          }(),
+                          ", ")));
     for (std::size_t i = 0; i < st.rows(); ++i) {
       const double g = rate->values[i], t = stress->values[i];
       if (std::isnan(g) || std::isnan(t)) {
@@ -1008,9 +1055,10 @@ FlowCurveRows flow_curve_rows(const RheometerFile& f, const std::string& step_sp
         continue;
       }
       if (!(g > 0.0) || !(t > 0.0))
-        throw InputError(fmt::format("{}:{}: step '{}': shear rate {} 1/s, shear stress {} Pa: a flow curve needs "
-                                     "both positive",
-                                     f.file, st.lines[i], st.name, g, t));
+        throw InputError(
+            fmt::format("{}:{}: step '{}': shear rate {} 1/s, shear stress {} Pa: a flow curve needs "
+                        "both positive",
+                        f.file, st.lines[i], st.name, g, t));
       out.shear_rate.push_back(g);
       out.shear_stress.push_back(t);
     }

@@ -33,9 +33,9 @@ RheometerFormat parse_rheometer_format(const std::string& text, const std::strin
 
 /// One column of one step: numbers in SI (NaN where the file has no value), or text.
 struct RheometerColumn {
-  std::string name;    ///< normalized name (shear_rate, shear_stress, viscosity, time, ...)
-  std::string header;  ///< the name as the file writes it
-  std::string unit;    ///< the unit as the file writes it ("" when none is given)
+  std::string name;     ///< normalized name (shear_rate, shear_stress, viscosity, time, ...)
+  std::string header;   ///< the name as the file writes it
+  std::string unit;     ///< the unit as the file writes it ("" when none is given)
   std::string si_unit;  ///< the unit of `values` ("1/s", "Pa", "Pa s", "s", "1" (dimensionless), ...)
   bool is_text = false;
   std::vector<double> values;     ///< numeric columns
@@ -43,10 +43,10 @@ struct RheometerColumn {
 };
 
 struct RheometerStep {
-  int index = 0;             ///< 1-based, in file order
-  std::string name;          ///< e.g. "Flow sweep - 2", "Flow curve 1 - 2", "Viscometry Table"
-  int line = 0;              ///< line where the step starts
-  std::vector<int> lines;    ///< the file's line of each row
+  int index = 0;           ///< 1-based, in file order
+  std::string name;        ///< e.g. "Flow sweep - 2", "Flow curve 1 - 2", "Viscometry Table"
+  int line = 0;            ///< line where the step starts
+  std::vector<int> lines;  ///< the file's line of each row
   std::vector<RheometerColumn> columns;
   std::size_t rows() const { return lines.size(); }
   /// The column with this normalized name, or nullptr.
