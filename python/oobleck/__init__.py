@@ -58,7 +58,7 @@ __version__ = "0.1.0"
 __all__ = [
     "InputError", "NumericalError", "Params", "FitResult", "Run", "presets", "load_params", "flow_curve",
     "shear_rate_dst", "structure", "volume_fraction", "viscosity_at", "fit", "point_shear", "point_relax",
-    "run", "open_run", "version",
+    "run", "open_run", "version", "read_rheometer",
 ]
 
 
@@ -312,6 +312,63 @@ def _read_data(data, name="data"):
     raise InputError(f"{name} = {data!r} ({type(data).__name__}): must be a pandas DataFrame or the path of a CSV file")
 
 
+def _read_exports(data, phi, step):
+    """The (phi, shear_rate, shear_stress) table of instrument exports, one per phi, as the CLI's
+    --data FILE [--step S] --phi PHI."""
+    files = [data] if isinstance(data, (str, os.PathLike)) else data
+    if not isinstance(files, (list, tuple)) or not all(isinstance(f, (str, os.PathLike)) for f in files):
+        raise InputError(f"data = {data!r}: with phi, the path of an instrument export or a list of them")
+    files = [os.fspath(f) for f in files]
+    phis = _numbers(phi, "phi")
+    steps = list(step) if isinstance(step, (list, tuple)) else [step] * len(files)
+    if len(phis) != len(files) or len(steps) != len(files):
+        raise InputError(f"data: {len(files)} export(s), phi: {len(phis)} value(s)"
+                         + (f", step: {len(steps)}" if isinstance(step, (list, tuple)) else "")
+                         + ": give one volume fraction (and step) per export")
+    pd = _pandas()
+    parts = []
+    for f, x, s in zip(files, phis, steps):
+        if not os.path.exists(f):
+            raise InputError(f"data = {f!r}: no such file")
+        rate, stress, _, _ = _core.rheometer_flow_curve(f, "" if s is None else str(s))
+        parts.append(pd.DataFrame({"phi": x, "shear_rate": rate, "shear_stress": stress}))
+    return pd.concat(parts, ignore_index=True), ", ".join(files)
+
+
+RHEOMETER_COLUMNS = ("step", "step_name", "time", "shear_rate", "shear_stress", "viscosity")
+
+
+def read_rheometer(path, format: str = "auto", *, step=None):
+    """A rheometer's export file as a DataFrame in SI, as ``oobleck rheology import``.
+
+    Formats (``format='auto'`` detects them from the content): 'trios' (TA TRIOS "Export to LIMS"
+    .txt), 'rheocompass' (Anton Paar RheoCompass CSV/TXT, also UTF-16 and decimal comma), 'rspace'
+    (Malvern rSpace CSV) and 'csv' (a header row of names with optional units in brackets or
+    parentheses; separator and decimal mark detected). Columns: RHEOMETER_COLUMNS (step: 1-based
+    index; step_name on every row; time [s], shear_rate [1/s], shear_stress [Pa], viscosity [Pa s],
+    NaN where the file has none), then the file's other columns under normalized names (step_time
+    [s], strain [-], torque [N m], temperature as read, ...). Every step, or only ``step`` (a name,
+    case-insensitive, TRIOS's ' - N' suffix optional, or an index). ``df.attrs``: file, format,
+    encoding, separator, decimal, sample, geometry (and instrument, operator, date, procedure,
+    project, test where the file names them), steps, units (the file's spellings per column),
+    si_units and metadata (every key/value line). Errors name the file, the line and what was
+    expected (InputError).
+    """
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputError(f"path = {path!r} ({type(path).__name__}): must be the path of an export file")
+    p = os.fspath(path)
+    if not os.path.exists(p):
+        raise InputError(f"path = {p!r}: no such file")
+    if not isinstance(format, str):
+        raise InputError(f"format = {format!r}: must be one of 'auto', 'trios', 'rheocompass', 'rspace', 'csv'")
+    raw = _core.read_rheometer(p, format, "" if step is None else str(step))
+    pd = _pandas()
+    df = pd.DataFrame(dict(zip(raw["names"], raw["columns"])))
+    df["step"] = df["step"].astype(int)
+    df.attrs.update(raw["attrs"])
+    return df
+
+
 def _column(df, col, where):
     if col not in df.columns:
         raise InputError(f"{where}: missing column '{col}' (columns present: {', '.join(map(str, df.columns))})")
@@ -405,7 +462,8 @@ class FitResult:
         return ax
 
 
-def fit(kind: str, data, params=None, *, terms=None, parameters=None, residual: str = "rate", bounds=None):
+def fit(kind: str, data, params=None, *, terms=None, parameters=None, residual: str = "rate", bounds=None, phi=None,
+        step=None):
     """Least-squares fit (Ceres) of the model to rheometer data; returns a :class:`FitResult`.
 
     kind: 'low' (a_0, phi_j; E12), 'high' (a_inf, phi_c; E13), 'dst' (eta_B terms; E14) exactly as
@@ -422,12 +480,24 @@ def fit(kind: str, data, params=None, *, terms=None, parameters=None, residual: 
     residual: curves only, 'rate' (ln shear rate at the measured stress; default) or 'stress'
       (ln shear stress at the measured rate, nearest branch).
     bounds: curves only, {name: (lower, upper)} in the parameter's unit, on top of the model's rules.
+    phi, step: curves only, instrument exports as ``rheology fit --data FILE [--step S] --phi PHI``:
+      data is one export's path or a list of them (TRIOS, RheoCompass, rSpace, CSV with units; see
+      :func:`read_rheometer`), phi their volume fractions (a number or a list as long), step the
+      step of each (a name or 1-based index, one for all or a list; default: the file's one step
+      with shear rate and stress).
     A parameter the data do not determine raises InputError naming it.
     """
     if not isinstance(kind, str) or kind not in ("low", "high", "dst", "curves"):
         raise InputError(f"kind = {kind!r}: must be one of 'low', 'high', 'dst', 'curves'")
     base = _params("hermes2016" if params is None else params)
-    df, where = _read_data(data)
+    if phi is not None:
+        if kind != "curves":
+            raise InputError(f"phi: only for kind 'curves' with instrument exports (not {kind!r})")
+        df, where = _read_exports(data, phi, step)
+    elif step is not None:
+        raise InputError("step: only with phi (instrument exports, kind 'curves')")
+    else:
+        df, where = _read_data(data)
     if kind != "curves":
         for arg, v in (("parameters", parameters), ("bounds", bounds)):
             if v is not None:

@@ -90,9 +90,14 @@ def volume_fraction(mass_fraction: float, rho_cs: float, rho_liquid: float, rho_
 def viscosity_at(params: ParamsLike, phi: float, shear_rate: Optional[Numbers] = None,
                  shear_stress: Optional[Numbers] = None,
                  full: bool = False) -> Union[np.ndarray, dict[str, np.ndarray]]: ...
-def fit(kind: str, data: Union[pd.DataFrame, str, os.PathLike], params: Optional[ParamsLike] = None, *,
+def fit(kind: str, data: Union[pd.DataFrame, str, os.PathLike, Sequence[Union[str, os.PathLike]]],
+        params: Optional[ParamsLike] = None, *,
         terms: Optional[int] = None, parameters: Optional[Sequence[str]] = None, residual: str = "rate",
-        bounds: Optional[dict[str, tuple[Optional[float], Optional[float]]]] = None) -> FitResult: ...
+        bounds: Optional[dict[str, tuple[Optional[float], Optional[float]]]] = None,
+        phi: Optional[Numbers] = None, step: Optional[Union[str, int, list]] = None) -> FitResult: ...
+RHEOMETER_COLUMNS: tuple[str, ...]
+def read_rheometer(path: Union[str, os.PathLike], format: str = "auto", *,
+                   step: Optional[Union[str, int]] = None) -> pd.DataFrame: ...
 def point_shear(params: ParamsLike, phi: float, *, shear_rate: Optional[float] = None,
                 shear_stress: Optional[float] = None, duration: float, dt: Optional[float] = None,
                 f0: float = 0.0, samples: int = 1000, **overrides: float) -> pd.DataFrame: ...

@@ -3,6 +3,7 @@
 // long computations without the GIL and maps oobleck::InputError / NumericalError to the Python
 // exceptions oobleck.InputError / oobleck.NumericalError with the same message. The Python
 // package (python/oobleck/__init__.py) builds DataFrames and the user-facing signatures on top.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -19,6 +20,7 @@
 
 #include "oobleck/core/build_info.hpp"
 #include "oobleck/core/error.hpp"
+#include "oobleck/io/rheometer.hpp"
 #include "oobleck/material/granular.hpp"
 #include "oobleck/material/point_driver.hpp"
 #include "oobleck/rheology/fit.hpp"
@@ -278,6 +280,72 @@ py::dict fit_curves(const std::vector<double>& phi, const std::vector<double>& r
   d["iterations"] = r.iterations;
   d["residual"] = rheology::to_string(o.residual);
   return d;
+}
+
+// ---- instrument exports ----------------------------------------------------------------------
+
+/// An export as the columns of oobleck.read_rheometer's DataFrame: {"names", "columns" (arrays of
+/// numbers or lists of str), "attrs"}.
+py::dict read_rheometer(const std::string& path, const std::string& format, const std::string& step) {
+  io::RheometerFile f;
+  io::RheometerTable t;
+  std::vector<std::size_t> steps;
+  {
+    py::gil_scoped_release release;
+    f = io::read_rheometer(path, io::parse_rheometer_format(format, "format"));
+    if (!step.empty()) steps = io::select_steps(f, step, "step");
+    t = io::to_table(f, steps);
+  }
+  py::list names, columns;
+  py::dict units, si_units, metadata;
+  for (const auto& c : t.columns) {
+    names.append(c.name);
+    if (c.is_text) {
+      columns.append(py::cast(c.text));
+    } else {
+      columns.append(to_array(c.values));
+    }
+    if (!c.si_unit.empty()) si_units[py::str(c.name)] = c.si_unit;
+    if (!c.units_read.empty()) units[py::str(c.name)] = c.units_read;
+  }
+  py::dict attrs;
+  attrs["file"] = path;
+  attrs["format"] = io::to_string(f.format);
+  attrs["encoding"] = f.encoding;
+  attrs["separator"] = std::string(1, f.separator);
+  attrs["decimal"] = std::string(1, f.decimal);
+  for (const char* key : {"sample", "geometry", "instrument", "operator", "date", "procedure", "project", "test"}) {
+    const auto it = f.attributes.find(key);
+    if (it != f.attributes.end()) attrs[key] = it->second;
+  }
+  for (const auto& [key, value] : f.attributes) metadata[py::str(key)] = value;
+  py::list step_names;
+  for (std::size_t k = 0; k < f.steps.size(); ++k) {
+    if (steps.empty() || std::find(steps.begin(), steps.end(), k) != steps.end()) step_names.append(f.steps[k].name);
+  }
+  attrs["steps"] = step_names;
+  attrs["units"] = units;
+  attrs["si_units"] = si_units;
+  attrs["metadata"] = metadata;
+  py::dict d;
+  d["names"] = names;
+  d["columns"] = columns;
+  d["attrs"] = attrs;
+  return d;
+}
+
+/// The flow-curve rows of an export (as `rheology fit --data FILE [--step S]`): shear rate
+/// [1/s], shear stress [Pa], the steps used, the rows skipped.
+py::tuple rheometer_flow_curve(const std::string& path, const std::string& step) {
+  io::FlowCurveRows rows;
+  std::vector<std::string> used;
+  {
+    py::gil_scoped_release release;
+    const io::RheometerFile f = io::read_rheometer(path);
+    rows = io::flow_curve_rows(f, step, fmt::format("step (for {})", path));
+    for (std::size_t k : rows.steps) used.push_back(f.steps[k].name);
+  }
+  return py::make_tuple(to_array(rows.shear_rate), to_array(rows.shear_stress), used, rows.skipped);
 }
 
 // ---- point experiments -----------------------------------------------------------------------
@@ -621,6 +689,8 @@ PYBIND11_MODULE(_oobleck, m) {
   m.def("fit_curves", &fit_curves, py::arg("phi"), py::arg("shear_rate"), py::arg("shear_stress"), py::arg("base"),
         py::arg("parameters"), py::arg("residual"), py::arg("bounds"), py::arg("where"));
   m.def("curves_default_parameters", &rheology::curves_default_parameters, py::arg("base"));
+  m.def("read_rheometer", &read_rheometer, py::arg("path"), py::arg("format"), py::arg("step"));
+  m.def("rheometer_flow_curve", &rheometer_flow_curve, py::arg("path"), py::arg("step"));
   m.def("point_shear", &point_shear, py::arg("params"), py::arg("phi"), py::arg("shear_rate"), py::arg("shear_stress"),
         py::arg("duration"), py::arg("dt"), py::arg("f0"), py::arg("samples"));
   m.def("point_relax", &point_relax, py::arg("params"), py::arg("phi"), py::arg("shear_rate"), py::arg("shear_stress"),
