@@ -5,13 +5,15 @@
 #include <sys/wait.h>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "oobleck/core/error.hpp"
 
 namespace oobleck::cli {
 
 void ParamsOption::add_to(CLI::App* cmd) {
-  auto* a = cmd->add_option("--preset", preset, "parameter set shipped in presets/ (e.g. hermes2016)");
+  auto* a = cmd->add_option("--preset", preset,
+                            fmt::format("parameter set shipped in presets/: {}", fmt::join(rheology::preset_names(), ", ")));
   auto* b = cmd->add_option("--params", params, "parameter file (TOML, same format as presets/*.toml)");
   a->excludes(b);
   b->excludes(a);

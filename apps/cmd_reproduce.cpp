@@ -24,8 +24,10 @@ namespace fs = std::filesystem;
 
 std::string self_exe() {
   std::error_code ec;
-  const auto p = fs::read_symlink("/proc/self/exe", ec);
-  return ec ? std::string("oobleck") : p.string();
+  std::string p = fs::read_symlink("/proc/self/exe", ec).string();
+  // Rebuilt while reproduce runs: Linux appends " (deleted)"; the path holds the new build.
+  if (const std::string gone = " (deleted)"; p.size() > gone.size() && p.ends_with(gone)) p.resize(p.size() - gone.size());
+  return ec ? std::string("oobleck") : p;
 }
 
 std::string quote(const std::string& s) {
@@ -467,7 +469,7 @@ void add_reproduce_command(CLI::App& app) {
   r->out = "out/reproduce";
   cmd->add_flag("--quick", r->quick, "coarse grids, short runs (minutes; what CI may run)");
   cmd->add_option("--out", r->out, "output folder")->capture_default_str();
-  cmd->add_option("--threads", r->threads, "OpenMP threads for the scene runs (default: all cores)");
+  cmd->add_option("--threads", r->threads, "OpenMP threads for the scene runs; 0 (the default) means all cores");
   cmd->add_option("--only", r->only,
                   "run only these parts (repeatable): steady, V (verification), S1, S2, S3, S4 (default: all)")
       ->check(CLI::IsMember({"steady", "V", "S1", "S2", "S3", "S4"}));

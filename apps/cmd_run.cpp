@@ -9,6 +9,7 @@
 #include "oobleck/run/runner.hpp"
 #include "oobleck/run/stop.hpp"
 #include "oobleck/scene/config.hpp"
+#include "oobleck/scene/key_list.hpp"
 
 namespace oobleck::cli {
 
@@ -21,6 +22,7 @@ void add_run_command(CLI::App& app) {
     long checkpoint_every = -1;
     long stop_after = -1;
     bool quiet = false;
+    bool list_keys = false;
   };
   auto o = std::make_shared<Opts>();
   cmd->add_option("scene", o->scene, "scene file (TOML)");
@@ -28,7 +30,7 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--set", o->sets,
                   "override a scene key: key.path=value or a short name from [aliases] (with --restart: [time] "
                   "keys only)");
-  cmd->add_option("--threads", o->threads, "OpenMP threads (default: all cores)");
+  cmd->add_option("--threads", o->threads, "OpenMP threads; 0 (the default) means all cores");
   cmd->add_option("--ranks-grid", o->ranks_grid,
                   "under mpirun: ranks per grid axis, e.g. 2x1 or 2x1x1 (default: the split with the fewest ghost "
                   "nodes)");
@@ -36,8 +38,15 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--restart", o->restart, "continue the run in this folder from its last checkpoint");
   cmd->add_option("--stop-after", o->stop_after, "stop after this many steps in total (leaves a checkpoint)");
   cmd->add_flag("--quiet", o->quiet, "no progress output");
+  cmd->add_flag("--list-keys", o->list_keys,
+                "print the scene's short names and keys with their values, units and meanings, and exit");
   cmd->callback([o] {
     if (o->threads < 0) throw InputError(fmt::format("--threads = {}: must be >= 0", o->threads));
+    if (o->list_keys) {
+      if (o->scene.empty()) throw InputError("run --list-keys: a scene file is required");
+      fmt::print("{}", scene::format_scene_keys(scene::list_scene_keys(o->scene)));
+      return;
+    }
     run::RunOptions ro;
     ro.threads = o->threads;
     ro.ranks_grid = o->ranks_grid;

@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "cli_common.hpp"
+#include "cli_usage.hpp"
 #include "oobleck/core/build_info.hpp"
 #include "oobleck/core/comm.hpp"
 #include "oobleck/core/error.hpp"
@@ -34,10 +35,11 @@ int run_cli(int argc, char** argv) {
   oobleck::cli::add_run_command(app);
   oobleck::cli::add_reproduce_command(app);
   oobleck::cli::add_sweep_command(app);
+  oobleck::cli::add_examples(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    return oobleck::cli::report_usage_error(app, e);
   } catch (const oobleck::run::Stopped& e) {
     fmt::print(stderr, "{}: {}\n", who(), e.what());
     return 128 + e.signal();
