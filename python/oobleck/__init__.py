@@ -497,6 +497,14 @@ def fit(kind: str, data, params=None, *, terms=None, parameters=None, residual: 
     elif step is not None:
         raise InputError("step: only with phi (instrument exports, kind 'curves')")
     else:
+        if kind == "curves" and isinstance(data, (str, os.PathLike)) and os.path.isfile(data):
+            try:  # an instrument export is named with what it needs
+                found = _core.read_rheometer(os.fspath(data), "auto", "")["attrs"]
+            except InputError:
+                found = {"format": "csv"}
+            if found["format"] != "csv":
+                raise InputError(f"{os.fspath(data)}: a {found['format']} export has no phi column: give its volume "
+                                 f"fraction, fit('curves', {os.fspath(data)!r}, phi=PHI, step=NAME_OR_INDEX)")
         df, where = _read_data(data)
     if kind != "curves":
         for arg, v in (("parameters", parameters), ("bounds", bounds)):

@@ -68,5 +68,7 @@ def test_errors_name_the_file_line_and_rule(data, tmp_path):
         oobleck.fit("curves", data / "trios_phi040.txt", phi=0.40, parameters=["a_0"])
     with pytest.raises(oobleck.InputError, match=r"data: 2 export\(s\), phi: 1 value"):
         oobleck.fit("curves", [data / "rspace_phi046.csv", data / "generic_phi048.csv"], phi=0.46)
+    with pytest.raises(oobleck.InputError, match=r"a rspace export has no phi column: give its volume fraction"):
+        oobleck.fit("curves", data / "rspace_phi046.csv")
     with pytest.raises(oobleck.InputError, match=r"phi: only for kind 'curves'"):
         oobleck.fit("low", data / "generic_phi048.csv", phi=0.48)
