@@ -240,7 +240,7 @@ io::CsvTable curves_table(const std::vector<Export>& exports, const std::string&
         throw InputError(
             fmt::format("{}: has a column 'phi' and --phi = {} was given: give one of them", e.file, e.phi));
     }
-    const io::FlowCurveRows rows = io::flow_curve_rows(f, e.step, fmt::format("--step (for {})", e.file));
+    const io::FlowCurveRows rows = io::flow_curve_rows(f, e.step, "--step");
     for (std::size_t k = 0; k < rows.shear_rate.size(); ++k)
       t.rows.push_back({e.phi, rows.shear_rate[k], rows.shear_stress[k]});
     if (!quiet) {

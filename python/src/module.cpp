@@ -342,7 +342,7 @@ py::tuple rheometer_flow_curve(const std::string& path, const std::string& step)
   {
     py::gil_scoped_release release;
     const io::RheometerFile f = io::read_rheometer(path);
-    rows = io::flow_curve_rows(f, step, fmt::format("step (for {})", path));
+    rows = io::flow_curve_rows(f, step, "step");
     for (std::size_t k : rows.steps) used.push_back(f.steps[k].name);
   }
   return py::make_tuple(to_array(rows.shear_rate), to_array(rows.shear_stress), used, rows.skipped);

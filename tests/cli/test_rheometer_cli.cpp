@@ -145,7 +145,8 @@ TEST_F(RheometerCli, BadExportsAndOptionsAreInputErrorsThatWriteNothing) {
   expect_error(fit + "--data " + kDir + "trios_phi040.txt",
                "a trios export has no phi column: give its volume fraction");
   expect_error(fit + "--data " + kDir + "trios_phi040.txt --phi 0.40",
-               "2 steps hold shear rate and stress (1 'Peak hold - 1', 2 'Flow sweep - 2'): choose with --step");
+               "2 steps hold shear rate and stress (1 'Peak hold - 1', 2 'Flow sweep - 2'): choose one with --step "
+               "NAME or INDEX");
   expect_error(fit + "--data " + kDir + "trios_phi040.txt --data " + kDir + "rspace_phi046.csv --phi 0.4",
                "--data given 2 times and --phi 1 times");
   expect_error("rheology fit --kind low --preset hermes2016 --out " + path("fit.toml") + " --data " + kDir +

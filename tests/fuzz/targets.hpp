@@ -17,6 +17,7 @@
 #include "oobleck/core/error.hpp"
 #include "oobleck/io/checkpoint.hpp"
 #include "oobleck/io/csv.hpp"
+#include "oobleck/io/rheometer.hpp"
 #include "oobleck/rheology/params.hpp"
 #include "oobleck/scene/config.hpp"
 
@@ -62,12 +63,21 @@ inline int params(const std::uint8_t* data, std::size_t size) {
   return 0;
 }
 
-/// A data CSV (`oobleck rheology fit --data`): the table, and every column it names.
+/// A data file (`oobleck rheology fit --data`, `rheology import`): oobleck's CSV table and every
+/// column it names; the same bytes as an instrument export (io/rheometer.hpp): its table, its
+/// flow-curve rows and the first step selected by name.
 inline int csv(const std::uint8_t* data, std::size_t size) {
   const std::string path = as_file(data, size, ".csv");
   try {
     const io::CsvTable t = io::read_csv(path);
     for (const auto& name : t.header) (void)t.column(name);
+  } catch (const InputError&) {
+  }
+  try {
+    const io::RheometerFile f = io::read_rheometer(path);
+    (void)io::to_table(f);
+    if (!f.steps.empty()) (void)io::select_steps(f, f.steps.front().name);
+    (void)io::flow_curve_rows(f, "");
   } catch (const InputError&) {
   }
   return 0;

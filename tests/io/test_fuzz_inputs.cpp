@@ -74,7 +74,9 @@ TEST(FuzzInputs, CsvReaderTakesEveryStoredInput) {
   auto inputs = stored("csv");
   const auto d = files_under(kRoot / "docs/fitting", ".csv");
   inputs.insert(inputs.end(), d.begin(), d.end());
-  EXPECT_GE(replay(oobleck::fuzz::csv, inputs), 8);
+  const auto e = files_under(kRoot / "tests/rheology/data/rheometer");  // instrument exports
+  inputs.insert(inputs.end(), e.begin(), e.end());
+  EXPECT_GE(replay(oobleck::fuzz::csv, inputs), 14);
 }
 
 TEST(FuzzInputs, CheckpointReaderTakesEveryStoredInput) {

@@ -198,8 +198,9 @@ TEST(Rheometer, StepSelectionByIndexAndNameIgnoresCaseAndTheIndexSuffix) {
                     HasSubstr("1 'Peak hold - 1', 2 'Flow sweep - 2'")));
   EXPECT_THAT(error_of([&] { (void)select_steps(f, "3"); }), HasSubstr("--step = 3: "));
   // Two steps with rate and stress: the fit must be told which.
-  EXPECT_THAT(error_of([&] { (void)flow_curve_rows(f, ""); }),
-              AllOf(HasSubstr("2 steps hold shear rate and stress"), HasSubstr("choose with --step")));
+  EXPECT_THAT(
+      error_of([&] { (void)flow_curve_rows(f, ""); }),
+      AllOf(HasSubstr("2 steps hold shear rate and stress"), HasSubstr("choose one with --step NAME or INDEX")));
   const auto rows = flow_curve_rows(f, "flow sweep");
   EXPECT_EQ(rows.shear_rate.size(), 16u);
   // Several intervals of one result share the name without the suffix.
