@@ -5,9 +5,14 @@
 
 s3: k_l / k_t / k_l/k_t (R² longitudinal / transverse) of the u_z = 0.5 v0 front, whole run
     (velocity_front.speeds) and up to each front's farthest extent (speeds_to_farthest).
+s3_recession: how far the u_z = 0.5 v0 front ran ahead of the tip (longitudinal) and past the
+    intruder's edge (transverse) before it fell back: farthest extent and its time, and the
+    extent at the end of the run (velocity_front.series).
 s1: the velocity band's farthest extent (front_farthest, _time), the front speed (front_speed, R²),
     the outer half's arrest (outer_arrest.peak, .time) and the structure front at the wall
     (structure_front_wall_time).
+s2: the rod's peak deceleration from the contact force (in g), its speed at 10 and 20 ms and at the
+    end, and reproduce's criterion (peak > 10 g and final speed < v0/2).
 s4: hub height initial -> final (min), distance, runs_on_surface, sinks.
 """
 import json
@@ -32,6 +37,25 @@ def s3(j):
     return [s3_cell(vf.get("speeds")), s3_cell(vf.get("speeds_to_farthest"))]
 
 
+def recession(frames, side, key):
+    """(farthest extent, its time, extent at the end) of one front, in mm and ms."""
+    found = [(f[side][key], f["time"]) for f in frames if f[side]["found"]]
+    if not found:
+        return None
+    far = max(found)
+    return far[0] * 1e3, far[1] * 1e3, found[-1][0] * 1e3
+
+
+def s3_recession(j):
+    frames = j["velocity_front"]["series"]["frames"]
+    cells = []
+    for side, key in (("longitudinal", "ahead"), ("transverse", "from_edge")):
+        r = recession(frames, side, key)
+        cells.append("no front" if r is None else
+                     f"{r[0]:.1f} mm at {r[1]:.1f} ms → {r[2]:.1f} mm ({100 * (r[0] - r[2]) / r[0]:.0f}% back)")
+    return cells
+
+
 def s1(j):
     a = j.get("outer_arrest") or {}
     fit = j.get("front_fit") or {}
@@ -39,6 +63,21 @@ def s1(j):
             f"{num(j.get('front_speed'), '{:.3f}')} m/s (R² {num(fit.get('r_squared'), '{:.3f}')}); "
             f"outer peak {num(a.get('peak'), '{:.2f}')}, arrest {num(a.get('time'), '{:.3f}')} s; "
             f"structure at the wall {num(j.get('structure_front_wall_time'), '{:.3f}')} s"]
+
+
+def s2(j):
+    v = j["rod_velocity"]
+    v0 = abs(v["value"][0])
+
+    def at(t):
+        i = min(range(len(v["time"])), key=lambda k: abs(v["time"][k] - t))
+        return abs(v["value"][i])
+
+    peak = j["peak_deceleration_from_force"]["peak_deceleration"] / 9.81
+    final = abs(j["final_velocity"])
+    met = peak > 10 and final < v0 / 2
+    return [f"{peak:.0f} g; {at(0.01):.2f}, {at(0.02):.2f} → {final:.2f} m/s; depth {1e3 * j['final_depth']:.0f} mm; "
+            f"{'met' if met else 'not met'}"]
 
 
 def s4(j):
@@ -50,7 +89,10 @@ def s4(j):
 CLAIMS = {
     "s3": (s3, ["whole run", "to farthest"],
            "k_l / k_t / **k_l/k_t** (R² longitudinal / transverse) of the u_z = 0.5 v_0 front"),
+    "s3_recession": (s3_recession, ["ahead of the tip", "past the edge"],
+                     "farthest extent of the u_z = 0.5 v_0 front (time) → extent at the end of the run"),
     "s1": (s1, [""], "band's farthest extent, front speed, outer half's arrest, structure front at the wall"),
+    "s2": (s2, [""], "peak deceleration (contact force); speed at 10, 20 ms → at the end; final depth; criterion"),
     "s4": (s4, [""], "hub initial → final (min), distance, the two criteria"),
 }
 
@@ -63,7 +105,7 @@ def main(claim, out):
         if not d.is_dir() or not s.is_file():
             continue
         variant, point = d.name.rsplit("_", 2)[0], "_".join(d.name.rsplit("_", 2)[1:])
-        if claim != "s3":
+        if not claim.startswith("s3"):
             variant, point = d.name.rsplit("_", 1)
         if point not in points:
             points.append(point)
