@@ -106,6 +106,17 @@ TEST(SceneConfig, ErrorsNameFileKeyAndRule) {
 
   e = error_with("", "", {"phi=1.5"});
   EXPECT_NE(e.find("region[0].phi"), std::string::npos) << e;
+  // A bed at or above the material's jamming fraction (hermes2016: phi_j = 0.535) is refused with
+  // the region, phi_j and the preset; just below it loads.
+  for (const char* phi : {"phi=0.535", "phi=0.6"}) {
+    e = error_with("", "", {phi});
+    EXPECT_NE(e.find("key 'region[0].phi'"), std::string::npos) << e;
+    EXPECT_NE(e.find("region 'region0'"), std::string::npos) << e;  // settling.toml's region has no name
+    EXPECT_NE(e.find("phi_j = 0.535 (preset hermes2016)"), std::string::npos) << e;
+  }
+  EXPECT_EQ(error_with("", "", {"phi=0.534"}), "");
+  e = error_with("", "", {"phi=0.5", "material.steady.phi_j=0.45", "material.steady.phi_c=0.40"});
+  EXPECT_NE(e.find("phi_j = 0.45"), std::string::npos) << e;
   // The linear kernels' mass floor: a fraction in [0, 1], and only with linear shape functions.
   e = error_with("", "", {"grid.linear_mass_floor=0.1"});
   EXPECT_NE(e.find("grid.linear_mass_floor"), std::string::npos) << e;

@@ -310,8 +310,11 @@ TransferConfig read_transfer(io::TomlReader& top) {
   return transfer;
 }
 
-/// One [[region]] table: a box of material points inside the grid.
-RegionConfig read_region(io::TomlReader& r, std::size_t index, const GridConfig& grid) {
+/// One [[region]] table: a box of material points inside the grid. A bed of grains must lie below
+/// the material's jamming fraction phi_j (E1: the packing at full structure), where the steady
+/// model has a flowing state.
+RegionConfig read_region(io::TomlReader& r, std::size_t index, const GridConfig& grid,
+                         const rheology::Preset& material) {
   const int dim = grid.dim;
   RegionConfig reg;
   reg.name = r.string_or("name", fmt::format("region{}", index));
@@ -327,6 +330,11 @@ RegionConfig read_region(io::TomlReader& r, std::size_t index, const GridConfig&
   reg.phi = has_grains ? r.number("phi") : r.number_or("phi", 0.0);
   if (has_grains) {
     r.require(reg.phi > 0 && reg.phi < 1, "phi", reg.phi, "must lie in (0, 1)");
+    r.require(reg.phi < material.steady.phi_j, "phi", reg.phi,
+              fmt::format("region '{}': must lie below the material's jamming fraction phi_j = {:g} ({}{}): a bed "
+                          "at or above phi_j has no flowing state",
+                          reg.name, material.steady.phi_j, material.name.empty() ? "its [material]" : "preset ",
+                          material.name));
   }
   reg.points_per_cell = static_cast<int>(r.number_or("points_per_cell", 2));
   r.require(reg.points_per_cell >= 1 && reg.points_per_cell <= 8, "points_per_cell", reg.points_per_cell,
@@ -352,11 +360,11 @@ RegionConfig read_region(io::TomlReader& r, std::size_t index, const GridConfig&
 }
 
 /// [[region]]: at least one.
-std::vector<RegionConfig> read_regions(io::TomlReader& top, const GridConfig& grid) {
+std::vector<RegionConfig> read_regions(io::TomlReader& top, const GridConfig& grid, const rheology::Preset& material) {
   auto regions = top.table_array("region");
   if (regions.empty()) top.fail("region", "missing: at least one [[region]] of material points is required");
   std::vector<RegionConfig> out;
-  for (std::size_t i = 0; i < regions.size(); ++i) out.push_back(read_region(regions[i], i, grid));
+  for (std::size_t i = 0; i < regions.size(); ++i) out.push_back(read_region(regions[i], i, grid, material));
   return out;
 }
 
@@ -792,7 +800,7 @@ SceneConfig load_scene(const std::string& path, const std::vector<std::string>& 
   read_fluid(top, c);
   c.coupling = read_coupling(top);
   c.transfer = read_transfer(top);
-  c.regions = read_regions(top, c.grid);
+  c.regions = read_regions(top, c.grid, c.material);
   c.boundary = read_boundary(top, path, c.grid);
   c.bodies = read_bodies(top, c);
   c.gravity_m_s2 = read_physics(top, c.grid);
