@@ -112,6 +112,9 @@ void add_examples(CLI::App& app) { add_examples_below(app); }
 
 int report_usage_error(CLI::App& app, const CLI::ParseError& e) {
   if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);  // --help, --version
+  // A command's own exit status, thrown from its callback (sweep: 3 when a run failed); it has
+  // printed its message.
+  if (dynamic_cast<const CLI::RuntimeError*>(&e) != nullptr) return e.get_exit_code();
   const CLI::App& cmd = deepest(app);
   std::string msg = unknown_word_message(cmd);
   if (msg.empty()) msg = e.what();

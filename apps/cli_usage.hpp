@@ -12,7 +12,8 @@ namespace oobleck::cli {
 void add_examples(CLI::App& app);
 
 /// Reports a parse error of `app` on stderr and returns the exit status: 0 for --help and
-/// --version (printed as CLI11 does), 1 for every usage error.
+/// --version (printed as CLI11 does), a command's own status thrown as CLI::RuntimeError(status)
+/// (printed nothing more), 1 for every usage error.
 int report_usage_error(CLI::App& app, const CLI::ParseError& e);
 
 }  // namespace oobleck::cli
