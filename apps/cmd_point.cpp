@@ -1,4 +1,4 @@
-// `oobleck point ...`: the granular law (model.md §3, E16–E24) at one homogeneous material point:
+// `oobleck point ...`: the granular law (E16–E24, docs/granular.md) at one homogeneous material point:
 // simple shear at fixed volume (rate- or stress-controlled) and relaxation after cessation of steady
 // shear beside the SI's reduced ODE.
 #include <chrono>

@@ -1,4 +1,4 @@
-// Granular return map (model.md E16–E24) throughput on one core for a realistic mix of regimes:
+// Granular return map (E16–E24, docs/equations.md) throughput on one core for a realistic mix of regimes:
 // steadily flowing points (f_1 and f_1 + f_3 active), relaxing points (compaction), jammed
 // elastic points and separated (tensile) points, at an MPM-like time step of 1e-6 s.
 #include <cmath>

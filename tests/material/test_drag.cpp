@@ -1,4 +1,4 @@
-// E29 drag law and the semi-implicit nodal update of model.md §5.
+// E29 drag law and the semi-implicit nodal update (docs/equations.md, fluid phase and coupling).
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
@@ -14,7 +14,7 @@ namespace m = oobleck::material;
 namespace {
 // Reference values of Beetstra's F̂(φ, Re) evaluated independently with 30-digit decimal
 // arithmetic (Python `decimal`), straight from the formula in Beetstra, van der Hoef & Kuipers,
-// AIChE J. 53 (2007) 489, eq. (13) as written in model.md E29.
+// AIChE J. 53 (2007) 489, eq. (13) as written in E29 (docs/equations.md).
 struct Tab {
   double phi, Re, F;
 };

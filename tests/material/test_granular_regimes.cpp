@@ -1,4 +1,4 @@
-// Individual regimes of the granular law against hand-derived results (model.md §3).
+// Individual regimes of the granular law against hand-derived results (E16–E24, docs/equations.md).
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -37,7 +37,7 @@ TEST(GranularRegimes, ElasticIncrementIsHypoelastic) {
   EXPECT_NEAR(st.f, 0.5 / (1.0 + dt * P.granular.K_0 * material::tau_bar(st.sigma) * inv_eta_B), 1e-14);
 }
 
-// The model.md pitfall: a loose state (phi < phi_m) at rest cannot hold pressure (E23 with zeta = 0
+// The authors' code's pitfall: a loose state (phi < phi_m) at rest cannot hold pressure (E23 with zeta = 0
 // gives f_3 = g(phi) p <= 0 => p = 0); the authors' elastic check misses this.
 TEST(GranularRegimes, LooseStateAtRestLosesPressure) {
   const material::GranularLaw law(test::preset("hermes2016"));

@@ -1,4 +1,4 @@
-// Robustness of the granular return map (model.md §3) over >= 1e5 random states: phi across
+// Robustness of the granular return map (E16–E24, docs/granular.md) over >= 1e5 random states: phi across
 // [0.3, 0.6] (through phi_m and beyond phi_j), strain rates +-1e-3..1e4 1/s in all tensor
 // directions, stresses 0..1e6 Pa including tension, dt 1e-7..1e-3 s. Every result must be finite
 // and converged, keep p >= 0, 0 <= tau_bar <= tau_bar^tr, f in [0, 1], and satisfy the active

@@ -1,4 +1,4 @@
-// Start-up and relaxation transients of the granular law (model.md §3, E24, SI "A Method for
+// Start-up and relaxation transients of the granular law (E24, SI "A Method for
 // Determining G and K_0"), against independent quasi-steady ODE references written here.
 #include <cmath>
 #include <cstdio>

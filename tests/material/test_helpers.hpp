@@ -1,6 +1,6 @@
 #pragma once
 // Shared helpers of the material tests: presets with overrides, and the closed-form steady state
-// (rheology::steady_point, model.md E11) at a given shear rate or structure.
+// (rheology::steady_point, E11 in docs/equations.md) at a given shear rate or structure.
 #include <cmath>
 #include <limits>
 #include <random>

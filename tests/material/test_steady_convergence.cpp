@@ -1,5 +1,5 @@
 // V1: rate- and stress-controlled homogeneous shear at fixed phi converges to the closed-form
-// steady flow curve of model.md §2 (E3–E5, E10, E11), evaluated independently by rheology::.
+// steady flow curve (E3–E5, E10, E11 of docs/equations.md), evaluated independently by rheology::.
 #include <cstdio>
 
 #include <gtest/gtest.h>

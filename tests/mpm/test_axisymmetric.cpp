@@ -1,4 +1,4 @@
-// Axisymmetric with swirl (model.md §7): V3 Taylor–Couette and a rigidly rotating annulus.
+// Axisymmetric with swirl (docs/mpm.md, "Geometry modes"): V3 Taylor–Couette and a rigidly rotating annulus.
 #include <gtest/gtest.h>
 
 #include <cmath>

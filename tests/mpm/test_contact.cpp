@@ -1,4 +1,4 @@
-// Bodies and contact (model.md §8, src/oobleck/mpm/contact.hpp): the node-level impulse rules,
+// Bodies and contact (docs/contact.md, src/oobleck/mpm/contact.hpp): the node-level impulse rules,
 // momentum conservation in free flight, a rigid block resting and sliding on an elastic bed
 // (static normal force = weight; Coulomb deceleration μ g), a prescribed intruder, and the motor.
 // Every reference is derived here (Newton's laws, Coulomb's law, the acoustic impedance), never
@@ -260,7 +260,7 @@ TEST(Contact, RigidBlockRestingOnElasticBedCarriesItsWeight) {
 }
 
 TEST(Contact, BlockSlidingWithFrictionDeceleratesAtMuG) {
-  // Coulomb (model.md §8, slip branch): a block sliding on the bed at v0 feels μ N = μ M g and
+  // Coulomb (docs/contact.md, slip branch): a block sliding on the bed at v0 feels μ N = μ M g and
   // decelerates at μ g until it stops; then it sticks (stick branch: no creep, v = 0).
   const double mu = 0.3, g = 9.81, v0 = 1.0;
   const double t_stop = v0 / (mu * g);  // 0.34 s

@@ -113,7 +113,7 @@ TEST(SettlingV4, FiniteReynoldsAndCarmanKozeny) {
 TEST(SettlingV4, AxisymmetricColumnSameVelocity) {
   // The same balance in axisymmetric mode: a cylinder r ∈ [0, R] (axis + frictionless outer
   // wall), periodic in z, gravity along −z. Masses and volumes are both per radian, so the nodal
-  // porosity n_i = 1 − m^s_i/(ρ_s V_i) is right (the pitfall of model.md §5).
+  // porosity n_i = 1 − m^s_i/(ρ_s V_i) is right (the authors' code mixes per-radian masses with whole volumes).
   const double phi = 0.3, rho_s = 1620.0, rho_f = 1000.0, g = 9.81, h = 1e-3, d = 5.85e-6, eta0 = 1e-3;
   const int cells = 8;
   Grid<2> grid(Vec<2>(0.0, 0.0), h, {cells, cells}, {false, true});

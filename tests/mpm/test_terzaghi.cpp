@@ -1,7 +1,7 @@
 // V5 (scenes.md): Terzaghi 1D consolidation of a two-phase column with an elastic skeleton (test-only
 // linear elastic granular law), impermeable fixed bottom, drained top loaded by a total stress q.
 //
-// Continuum (mixture theory of model.md §4–5, no gravity, quasi-static): the fluid momentum balance
+// Continuum (mixture theory, E25–E29 of docs/equations.md; no gravity, quasi-static): the fluid momentum balance
 // −n∇p + C_V (v_s − v_f) = 0 is Darcy's law n (v_f − v_s) = −(k/η)∇p with k/η = n²/C_V; the
 // skeleton σ̃_yy = M ε_yy (M = λ + 2μ) with σ̃ − p = −q constant; fluid mass (E27 with
 // ρ_f = ρ_f0 e^{p/κ}): (n/κ) ṗ = −div q. Together ṗ = c_v p_yy with c_v = (k/η)/(1/M + n/κ).

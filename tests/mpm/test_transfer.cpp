@@ -1,4 +1,4 @@
-// P2G and G2P (model.md §6 steps 1, 2, 6, 7) against the textbook node-by-node sums.
+// P2G and G2P (docs/mpm.md, "The step": phases 2 and 6) against the textbook node-by-node sums.
 //
 // The solver's transfers factorise the tensor-product shape functions row by row in 2D and compute
 // the shape functions inside P2G; here every nodal and point quantity is summed again directly,

@@ -57,7 +57,7 @@ inline double gamma_dot_dst(const Fit& p, double phi) {
          std::pow(2 * p.mu_c * std::pow(eta_B(p, phi) / p.eta_0 * a * phi / (p.phi_j - phi), 2), -1.0 / 3.0);
 }
 
-// The steady flow curve at structure f (model.md E11 with xi_dot_eps = 0, from E6 = 0), with
+// The steady flow curve at structure f (E11 of docs/equations.md with xi_dot_eps = 0, from E6 = 0), with
 // phi_m(f) = phi_j + (phi_c - phi_j) f (E1), a(f) = a_0 + (a_inf - a_0) f (E2) and
 // c = tau_bar/(eta_0 gamma_dot) = eta_r - 1 - (5/2) phi, eta_r written out from E3.
 inline double gamma_dot_of_f(const Fit& p, double phi, double f) {

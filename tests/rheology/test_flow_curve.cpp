@@ -1,4 +1,4 @@
-// Steady flow curves (model.md §2) against the paper's closed forms, written independently in
+// Steady flow curves (docs/equations.md, steady rheology) against the paper's closed forms, written independently in
 // paper_tables.hpp: E12/E13 asymptotes at the curve ends, E14 DST rate on the DST branch, and
 // E10 (f = H f_m/(H + S)) satisfied by every row.
 #include <cmath>

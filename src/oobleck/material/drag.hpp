@@ -1,5 +1,5 @@
 #pragma once
-// Interphase drag (model.md §5, E29) and its semi-implicit nodal update.
+// Interphase drag (E29, docs/equations.md, fluid phase and coupling) and its semi-implicit nodal update.
 //
 //   E29  f_d = C_V (v_s − v_f),  C_V = 18 φ (1−φ) η_0 / d² · F̂(φ, Re)      [force per mixture volume]
 //        Re = |v_s − v_f| n ρ_f d / η_0
@@ -91,7 +91,7 @@ inline double drag_coefficient_per_volume(const DragParams& p, double phi, doubl
 /// step, a log and two exps per mixture node.
 void drag_coefficient_per_volume_block(const DragParams& p, const double* phi, const double* Re, double* C_V);
 
-/// Semi-implicit nodal drag (model.md §5). Given the nodal masses m_s, m_f [kg], the predicted
+/// Semi-implicit nodal drag (E29, docs/equations.md). Given the nodal masses m_s, m_f [kg], the predicted
 /// velocities v_s*, v_f* [m/s] that include every other force of the step, the nodal drag
 /// coefficient C [kg/s] and Δt [s], returns the drag force F_d [N] on the fluid (the grains get
 /// −F_d):

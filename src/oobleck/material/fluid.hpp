@@ -1,5 +1,5 @@
 #pragma once
-// Fluid phase law (model.md §4, E25–E27) as pure per-point functions. They know nothing of
+// Fluid phase law (E25–E27, docs/equations.md) as pure per-point functions. They know nothing of
 // grids or bodies: the MPM solver and any point driver call them with a point's state.
 //
 //   E25  τ_f = η_0 (1 + (5/2) φ) (∇v_f + ∇v_fᵀ − (2/3) div v_f 1)   (Einstein-corrected viscosity)
@@ -46,7 +46,7 @@ inline double fluid_pressure_from_density(double rho_f, double rho_f0, double ka
 
 /// E27, integrated exponentially over one step with div q and n frozen:
 /// J ← J exp(Δt div q / n), q = (1−n) v_s + n v_f evaluated at the nodes and interpolated.
-/// `porosity` n must be > 0 (the solver clamps it with a named minimum, model.md §5).
+/// `porosity` n must be > 0 (the solver clamps it with a named minimum, E28 in docs/equations.md).
 inline double update_fluid_volume_ratio(double J, double div_q_per_s, double porosity, double dt_s) {
   return J * std::exp(dt_s * div_q_per_s / porosity);
 }
@@ -73,7 +73,7 @@ inline Eigen::Matrix3d fluid_cauchy_stress(const Eigen::Matrix3d& L, double phi,
   return fluid_cauchy_stress_at_pressure(L, phi, fluid_pressure(J, p.kappa_Pa), p.eta_0_Pa_s);
 }
 
-/// Fluid pressure-wave speed √(κ/ρ_f) [m/s] used by the stable time step (model.md §6).
+/// Fluid pressure-wave speed √(κ/ρ_f) [m/s] used by the stable time step (docs/mpm.md, "The step").
 inline double fluid_wave_speed(double kappa_Pa, double rho_f_kg_m3) { return std::sqrt(kappa_Pa / rho_f_kg_m3); }
 
 }  // namespace oobleck::material

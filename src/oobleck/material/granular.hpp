@@ -23,7 +23,7 @@
 
 namespace oobleck::material {
 
-/// Which set of constraints is active at the end of the step (model.md §3, "Return mapping").
+/// Which set of constraints is active at the end of the step (docs/granular.md, "Algorithm").
 enum class GranularRegime : std::uint8_t {
   kElastic = 0,          ///< gamma_dot^p = 0, xi_dot_1 = xi_dot_2 = 0: f_1 <= 0, f_2 <= 0, f_3 <= 0 at the trial state
   kSeparated = 1,        ///< f_2 active (p = 0, sigma = 0, xi_dot_1 >= 0): grains out of contact (E22)
@@ -85,7 +85,7 @@ enum class JammedStructure : std::uint8_t {
 
 /// How f_{n+1} (E24) is coupled to the return map.
 enum class StructureUpdate : std::uint8_t {
-  kStaggered,  ///< return map with f_n, then the linearly implicit E24 step (model.md §3)
+  kStaggered,  ///< return map with f_n, then the linearly implicit E24 step (docs/granular.md)
   kImplicit,   ///< monolithic backward Euler: the return map uses f_{n+1} (scalar solve in f)
   kAuto,       ///< staggered unless dt (H' + S') > stiff_structure, then implicit (default)
 };

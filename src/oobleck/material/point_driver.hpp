@@ -1,5 +1,5 @@
 #pragma once
-// Homogeneous material-point experiments with the granular law (model.md §3): simple shear at
+// Homogeneous material-point experiments with the granular law (E16–E24, docs/equations.md): simple shear at
 // fixed volume, rate- or stress-controlled, and stress relaxation after cessation of steady shear
 // (the SI's method for G and K_0) beside the SI's reduced ODE. Used by `oobleck point` and tests.
 #include <functional>
@@ -100,7 +100,7 @@ double steady_rate_at_stress(const rheology::SteadyParams& s, double phi, double
 /// state for any dt), then D = W = 0. `law` carries G and K_0.
 RelaxResult run_relax(const GranularLaw& law, const RelaxOptions& o, const Progress& progress = {});
 
-/// The SI's reduced relaxation ODE (model.md §3): d tau_bar/dt = -G gamma_dot^p,
+/// The SI's reduced relaxation ODE (docs/granular.md, "Notes on the SI"): d tau_bar/dt = -G gamma_dot^p,
 /// gamma_dot^p = tau_bar/(c(f) eta_0) with c(f) = mu_1 eta_n + (5/2) phi^2/(phi_m - phi) (E3–E5),
 /// f from E24. Integrated with classical RK4 on substeps of 1/20 of the fastest time scale.
 /// Advances (tau_bar, f) from t to t + span.

@@ -56,10 +56,10 @@ class StressLaw {
   virtual void end_update(Body<G>& body, double dt_s, std::int64_t first_bad) = 0;
   /// How the solver should schedule the chunks (see ScheduleHint).
   virtual ScheduleHint schedule_hint() const { return {}; }
-  /// Fastest wave speed [m/s] at the current state (for the stable time step, model.md §6).
+  /// Fastest wave speed [m/s] at the current state (for the stable time step, docs/mpm.md "The step").
   virtual double max_wave_speed(const Body<G>& body) const = 0;
   /// Largest stable Δt [s] of the law's own diffusion on a grid of cell size h (viscous limit
-  /// ρ h²/(2η), model.md §6); +∞ for laws without one.
+  /// ρ h²/(2η), docs/mpm.md "The step"); +∞ for laws without one.
   virtual double viscous_dt_limit(const Body<G>& /*body*/, double /*h_m*/) const { return INFINITY; }
   /// Short name for messages.
   virtual const char* name() const = 0;

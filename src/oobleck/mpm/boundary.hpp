@@ -1,5 +1,5 @@
 #pragma once
-// Walls as mirror planes (model.md §6 step 4, §7 walls).
+// Walls as mirror planes (docs/mpm.md, "The step" phases 3 and 5; "Grid, shape functions and boundary conventions").
 //
 // Convention (docs/mpm.md): a wall lies on the face node plane of a non-periodic axis (logical
 // index 0 or cells). The shape functions are not modified near it; instead the two ghost layers

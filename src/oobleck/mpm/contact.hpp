@@ -1,5 +1,5 @@
 #pragma once
-// Third bodies and their contact with the mixture (model.md §8).
+// Third bodies and their contact with the mixture (docs/contact.md).
 //
 // * Rigid bodies are ordinary material-point bodies (so they scatter a nodal mass field and a mass
 //   gradient for the contact normal) whose points move rigidly instead of following the grid:
@@ -11,12 +11,12 @@
 //                   `free_mask` entry is 0 are held (axisymmetric: only v_z is free).
 // * Elastic bodies are Solid bodies with any law (LinearElasticLaw): the contact impulses change
 //   their nodal velocities like any other force; a `Motor` holds their mean angular velocity.
-// * Contact (model.md §8) at every node where the solid and the mixture (grains and/or fluid) both
+// * Contact (docs/contact.md) at every node where the solid and the mixture (grains and/or fluid) both
 //   have mass *and their nodal volumes overlap*: Σ_p N_ip V_p summed over the solid's and the
 //   mixture's points is ≥ θ V_node (θ = `overlap_threshold`, 0.98; V_node = h^D, per radian h² r).
 //   By the partition of unity two bodies that exactly touch fill every node's volume (sum = 1),
 //   a gap leaves it below 1, and at a corner next to empty space it is well below 1. The pure
-//   "both have mass" rule of model.md §8 (θ = 0) acts up to a cell early at every edge (see
+//   "both have mass" rule of the model (θ = 0) acts up to a cell early at every edge (see
 //   docs/contact.md for what it does to a sliding block). The outward normal of the solid is
 //   n = ∇m_b/|∇m_b| with ∇m_b,i = Σ_p m'_p ∇N_i(x_p), m'_p the point's mass in the grid's plane
 //   (normal_weight: m_p/r_p in axisymmetric mode). At a node outside the body every ∇N_i(x_p)
@@ -36,7 +36,7 @@
 //   on the grains is min(μ |J_s|, m_red |w_t|) against the tangential relative velocity w_t after
 //   the normal step, m_red = m_s m_b/(m_s + m_b) (m_s for a prescribed body: infinite mass).
 //   Everything is an impulse [kg m/s] on the nodal momenta; a force is impulse/Δt. (The authors'
-//   stick branch used the stick momentum as a force, a missing 1/Δt: model.md §8 [pitfall]. Here
+//   stick branch used the stick momentum as a force, a missing 1/Δt (docs/contact.md, "Units"). Here
 //   stick and slip are both impulses, so they cannot disagree in units.)
 //   The solid receives J_b = −(J_s + J_f) at each node: momentum is conserved exactly node by node.
 // * A prescribed body has infinite mass in the contact: v_n* = v_b·n, and J_b is the reaction.
@@ -70,7 +70,7 @@
 
 namespace oobleck::mpm {
 
-/// How a body's points move (model.md §8).
+/// How a body's points move (docs/contact.md).
 enum class BodyMotion {
   Deformable,  ///< ordinary MPM body (law, G2P)
   Prescribed,  ///< rigid, every point at `RigidMotion::velocity_m_s`, forever
@@ -115,7 +115,7 @@ struct RigidShape {
   }
 };
 
-/// Contact between one solid body and the mixture (grains and/or fluid), model.md §8.
+/// Contact between one solid body and the mixture (grains and/or fluid), docs/contact.md.
 template <class G>
 struct ContactPair {
   static constexpr int NC = G::ncomp;
@@ -126,7 +126,7 @@ struct ContactPair {
   Vec<NC> impulse_sum_N_s = Vec<NC>::Zero();    ///< Σ over all steps of the impulse on the solid
   /// Contact detection (see header): a node is a contact candidate where both have mass and the
   /// nodal volumes overlap, (V_b,i + V_mix,i) ≥ overlap_threshold · V_node,i. 0 disables the
-  /// volume test (contact wherever both have mass, model.md §8 literally).
+  /// volume test (contact wherever both have mass, the model literally).
   double overlap_threshold = 0.98;
   /// Normal from the solid's mass gradient alone (false), or the combined normal of the pair
   /// n = (∇m_b − ∇m_mix)/|∇m_b − ∇m_mix| (true, default; the mixture's mass gradient from its
@@ -144,7 +144,7 @@ struct ContactPair {
   void declare_fields(FieldList& list) { list.add_values("impulse_sum", {impulse_sum_N_s.data(), NC}, "N s"); }
 };
 
-/// Velocity-level motor (model.md §8, wheel): before each step, the mean angular velocity of the
+/// Velocity-level motor (docs/contact.md, wheel): before each step, the mean angular velocity of the
 /// body about its centre of mass in the plane of the first and the last axis (plane strain: x, y;
 /// 3D: x, z, the rotation about the y axis, counter-clockwise from +x towards +z, as in plane
 /// strain), ω̄ = Σ m (x − x_c) × (v − V_c) / Σ m |x − x_c|² with both vectors taken in that plane,
@@ -263,7 +263,7 @@ void apply_motor(Motor<G>& motor, Body<G>& body, const Grid<G::dim>& grid, bool 
 }
 
 /// Predicted velocity of a rigid body (its mass rm.mass_kg set by the caller, over every rank);
-/// its nodal velocity (and v_old) set to the rigid velocity on every node with mass (model.md §8).
+/// its nodal velocity (and v_old) set to the rigid velocity on every node with mass (docs/contact.md).
 template <class G>
 void predict_rigid(RigidMotion<G>& rm, GridField<G>& field, const Vec<G::ncomp>& gravity, double dt_s) {
   rm.predicted_m_s = rm.velocity_m_s;
@@ -282,7 +282,7 @@ void predict_rigid(RigidMotion<G>& rm, GridField<G>& field, const Vec<G::ncomp>&
 
 /// The weight of point p in a contact normal's mass gradient: the point's mass in the grid's
 /// plane, m_p in plane strain (and 3D); in axisymmetric mode (masses per radian, m_p = ρ_p A_p r_p,
-/// model.md §7) m_p/r_p = ρ_p A_p, the mass of its cross-section in the (r, z) plane. Σ_p ρ_p A_p ∇N_ip
+/// docs/mpm.md) m_p/r_p = ρ_p A_p, the mass of its cross-section in the (r, z) plane. Σ_p ρ_p A_p ∇N_ip
 /// is the gradient of the smoothed density, zero inside a uniform body: the normal is a property
 /// of the body's shape. The per-radian masses would add the gradient of the factor r,
 /// Σ_p m_p ∇N_ip ≈ ρ ∫ r ∇N_i dA = −ρ ∫ N_i dA ê_r (−ρ h² ê_r per node) inside a uniform body;
@@ -354,7 +354,7 @@ bool contact_normal(const ContactPair<G>& pair, const Vec<G::dim>* mixture_gradi
   return true;
 }
 
-/// Contact impulses at one node (model.md §8; the algorithm is in the header comment).
+/// Contact impulses at one node (docs/contact.md; the algorithm is in the header comment).
 /// n: unit outward normal of the solid; m_b = +∞ (std::isinf) for a prescribed body; m_s or m_f
 /// = 0 for a phase absent at the node. Returns the impulses on the grains (J_s) and the fluid
 /// (J_f); the solid receives −(J_s + J_f). Velocities are not modified.
@@ -461,7 +461,7 @@ double node_measure(const Grid<G::dim>& grid, int i) {
   return G::measure(grid.node_position(i), grid.cell_volume());
 }
 
-/// Resolve one contact pair at every node (model.md §8): impulses applied to the nodal velocities
+/// Resolve one contact pair at every node (docs/contact.md): impulses applied to the nodal velocities
 /// of the grains, the fluid and a deformable solid (a rigid one only accumulates them), summed
 /// with the node weights into pair.force_N. Serial over nodes (deterministic sums; the solid
 /// occupies few nodes). Returns the total impulse on the solid (over every rank: across_ranks).
@@ -501,7 +501,7 @@ Vec<G::ncomp> resolve_contact(ContactPair<G>& pair, const RigidMotion<G>& rm, Gr
   return finish_pair_sums(pair, J_body, J_grains, active, across_ranks, dt_s);
 }
 
-/// Contact of a *free rigid* body with the mixture, solved for the body as a whole (model.md §8 in
+/// Contact of a *free rigid* body with the mixture, solved for the body as a whole (docs/contact.md, in
 /// the rigid limit). Per-node two-body sharing with the body's partial nodal masses lets a rigid
 /// body overtake the mixture it pushes (its fringe nodes share their velocity, the body does
 /// not slow): a rod sank through a fluid that way. Here every approaching phase k at every

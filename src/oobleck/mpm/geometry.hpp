@@ -1,5 +1,5 @@
 #pragma once
-// Geometry policies and small fixed-size types of the MPM solver (model.md §7).
+// Geometry policies and small fixed-size types of the MPM solver (docs/mpm.md, "Geometry modes").
 //
 // A geometry policy says how many spatial dimensions the grid has (`dim`) and how many velocity
 // components a point carries (`ncomp`), and supplies the geometry-specific pieces of the step:
@@ -58,7 +58,7 @@ struct ThreeD {
   }
 };
 
-/// Axisymmetric with swirl (model.md §7): grid (r, z), velocity and 3×3 tensors in (r, z, θ)
+/// Axisymmetric with swirl (docs/mpm.md, "Geometry modes"): grid (r, z), velocity and 3×3 tensors in (r, z, θ)
 /// order. Masses and volumes are per radian (m = ρ A r, V = A r). The weak form per radian gives,
 /// per point and scaled by N_ip (dV = r dr dz):
 ///   f_r −= σ_θθ V/r,  f_θ += σ_rθ V/r                         (hoop terms)

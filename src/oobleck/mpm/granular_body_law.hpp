@@ -1,7 +1,7 @@
 #pragma once
 // Adapter that plugs the granular law (material/granular.hpp, E16–E24) into a grain body.
 // State per point: the structure f; the stress lives in the body. phi_p = m_p/(rho_s V_p) (granular
-// mass conservation, model.md §3) is clamped into (0, 1) before the call. A point whose update
+// mass conservation) is clamped into (0, 1) before the call. A point whose update
 // fails (non-convergence, non-finite input) stops the run with a diagnosis naming the point, the
 // law, its state and inputs (NumericalError), never a silent NaN.
 #include <algorithm>

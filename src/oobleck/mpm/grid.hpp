@@ -1,5 +1,5 @@
 #pragma once
-// Uniform Cartesian background grid (model.md §6–7).
+// Uniform Cartesian background grid (docs/mpm.md, "Grid, shape functions and boundary conventions").
 //
 // Conventions (docs/mpm.md):
 // * The physical domain of axis a is [origin_a, origin_a + cells_a h]; its nodes have *logical*

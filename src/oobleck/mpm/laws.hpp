@@ -44,7 +44,7 @@ class LinearElasticLaw final : public StressLaw<G> {
 
 /// Fluid phase of a mixture (E25–E27). State: ln J, J = ρ_f0/ρ_f, per point. Needs body.phi and
 /// body.div_q_1_s, which the solver's G2P fills for the fluid body from the nodal porosity and
-/// mixture flux. `min_porosity` bounds n in the J update (model.md §5).
+/// mixture flux. `min_porosity` bounds n in the J update (E27, docs/equations.md).
 template <class G>
 class FluidLaw final : public StressLaw<G> {
  public:

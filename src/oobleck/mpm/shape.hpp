@@ -1,6 +1,6 @@
 #pragma once
 // Shape functions (one small struct per kind) and the per-point cache of node indices, weights,
-// gradients and node offsets, computed once per step (model.md §6 step 1).
+// gradients and node offsets, computed once per step (in P2G, docs/mpm.md "The step" phase 2).
 //
 // Every kernel is a 1D function evaluated in cell units: given the point coordinate ξ = (x − x_0)/h
 // it returns the logical index `base` of its first support node and, for the `support` nodes
@@ -208,7 +208,7 @@ for_each_node(const Stencil<D, S>& s, F&& f) {
 }
 
 /// Per-point cache of the shape functions of one body: one Stencil per point (computed once per
-/// step, model.md §6 step 1), sized for the kernel's support S (one of the three arrays is used),
+/// step, in P2G: docs/mpm.md "The step" phase 2), sized for the kernel's support S (one of the three arrays is used),
 /// and `inv_D`, the diagonal of APIC's inverse inertia D_p⁻¹ [1/m²] (unused for linear weights).
 /// K = S^D nodes per point. Buffers grow only when the number of points grows (no allocation in a
 /// steady step). The per-node accessors are for tests and cold code; hot loops use

@@ -1,5 +1,5 @@
 #pragma once
-// The explicit MPM step (model.md §6, update-stress-last) for any number of bodies on one grid.
+// The explicit MPM step (docs/mpm.md, "The step": update-stress-last) for any number of bodies on one grid.
 //
 //   Solver<PlaneStrain> s(grid, options);
 //   auto& b = s.add_body("bar");  b.set_law(std::make_unique<LinearElasticLaw<PlaneStrain>>(p));
@@ -7,8 +7,8 @@
 //   while (s.time_s() < T) s.step();
 //
 // Each body has its own grid field. The phase coupling (porosity, buoyancy split, semi-implicit
-// drag, model.md §5) runs in `update_grid_and_couple()` between the wall folding and the boundary
-// conditions; contact with third bodies (§8, contact.hpp) scatters its mass gradients beside it
+// drag, E28–E29 of docs/equations.md) runs in `update_grid_and_couple()` between the wall folding and the boundary
+// conditions; contact with third bodies (docs/contact.md, contact.hpp) scatters its mass gradients beside it
 // (`scatter_contact_gradients()`, on one thread of that pass) and follows it in
 // `resolve_contacts()`.
 // Rigid bodies (prescribed or free translation) and motors: see contact.hpp and docs/contact.md.
@@ -42,7 +42,7 @@ namespace oobleck::mpm {
 /// Role of a body: a single-phase solid, or the granular or fluid phase of the mixture.
 enum class Phase { Solid, Grains, Fluid };
 
-/// Mixture parameters (model.md §5), used when a Fluid body exists (the drag and porosity only
+/// Mixture parameters (docs/equations.md, E28–E29), used when a Fluid body exists (the drag and porosity only
 /// with a Grains body as well).
 template <class G>
 struct MixtureOptions {
@@ -168,7 +168,7 @@ class Solver {
     return *bodies_.back();
   }
 
-  // ---- Third bodies and contact (model.md §8, contact.hpp) -------------------------------------
+  // ---- Third bodies and contact (docs/contact.md, contact.hpp) ----------------------------------
 
   /// Make body b rigid, every point moving at v until the next call (intruder; called before
   /// each step to ramp it up); the contact force on it is the reaction the drive must supply.
@@ -189,7 +189,7 @@ class Solver {
   }
   RigidMotion<G>& rigid_motion(int b) { return rigid_[b]; }
   /// Contact between solid body b and the mixture (its grains and/or fluid body), Coulomb
-  /// coefficient μ between solid and grains (model.md §8). Returns the pair index.
+  /// coefficient μ between solid and grains (docs/contact.md). Returns the pair index.
   int add_contact(int b, double friction_coefficient) {
     check_solid(b, "contact");
     if (!(friction_coefficient >= 0.0))
@@ -303,7 +303,7 @@ class Solver {
   std::int64_t points_migrated() const { return points_migrated_; }
 
   /// Largest stable Δt [s]: the CFL condition on the fastest wave of every body
-  /// (Δt ≤ cfl h / (c + |v|_max)) and the laws' viscous limits ρ h²/(2η) (model.md §6). The
+  /// (Δt ≤ cfl h / (c + |v|_max)) and the laws' viscous limits ρ h²/(2η) (docs/mpm.md, "The step"). The
   /// drag is semi-implicit and never limits Δt.
   double stable_dt(double cfl = 0.5) const {
     const auto [dt_wave, dt_visc] = time_step_limits(cfl);
@@ -327,7 +327,7 @@ class Solver {
     return {c_max > 0.0 ? cfl * grid_.h_m / c_max : INFINITY, dt_visc};
   }
 
-  /// Refuse a time step above the stable one (model.md §6): throws InputError with the numbers.
+  /// Refuse a time step above the stable one (docs/mpm.md, "The step"): throws InputError with the numbers.
   void check_time_step(double cfl = 0.5) const {
     const double dt_max = stable_dt(cfl);
     if (opt_.dt_s > dt_max)
@@ -342,7 +342,7 @@ class Solver {
     with_support([&](auto S) {
       constexpr int K = ipow(decltype(S)::value, D);
       StepClock clock(timings_);
-      apply_motors();                                       // 1. motors: velocity-level drive of driven bodies (§8)
+      apply_motors();                                       // 1. motors: velocity drive of driven bodies (contact.hpp)
       particles_to_grid_all<K>();                           // 2. P2G: shape functions, mass, momentum, forces, gravity
       if (halo_) timed_exchange([&] { sum_to_owners(); });  // (decomposed: partial sums to the owners)
       clock.lap(timings_.p2g);
@@ -351,12 +351,12 @@ class Solver {
       update_grid_and_couple(                           // 3. grid: walls fold ghosts, rigid predictions; porosity,
           [this] { scatter_contact_gradients<K>(); });  // buoyancy (E28), v = (mv + Δt f)/m,
                                                         //    drag (E29); beside it, contact's mass gradients
-      resolve_contacts();                               // 4. contact impulses (§8), rigid bodies' velocities
+      resolve_contacts();                               // 4. contact impulses (contact.hpp), rigid bodies' velocities
       clock.lap(timings_.grid);
       update_points<K>(clock);                  // 5. walls on nodal velocities, mixture flux q (E27);
                                                 // 6. G2P: x, v (APIC or FLIP/PIC), C, L, V ← V exp(Δt tr L);
                                                 // 7. laws: stresses (and their state) from L
-      keep_mixture_out_of_free_rigid_bodies();  // 8. mixture points back out of free rigid bodies (§8)
+      keep_mixture_out_of_free_rigid_bodies();  // 8. mixture points back out of free rigid bodies (contact.hpp)
       if (dec_) {                               // (decomposed: points to their new blocks)
         timed_exchange([&] {
           for (auto& b : bodies_) points_migrated_ += migrate_points(*b, *dec_);
@@ -401,7 +401,7 @@ class Solver {
     }
   }
 
-  /// Phase 2, P2G (model.md §6 steps 1–3) of every body in one region: each point's shape
+  /// Phase 2, P2G (docs/mpm.md, "The step") of every body in one region: each point's shape
   /// functions (into its body's cache) and its scatter, then the nodal sums and gravity. Every
   /// thread scatters its static share of each body's points into its copy of that body's nodal
   /// arrays, with no barrier between the bodies; after one barrier, each thread sums the copies
@@ -529,7 +529,7 @@ class Solver {
   ///    (E28), and the same split of a background gradient −V_i ∇p_0 (the viscous τ_f already acts
   ///    on the fluid alone);
   ///  * predicted velocities v = (mv + Δt f)/m (step 5), also of the deformable solids;
-  ///  * semi-implicit drag (model.md §5, E29): C_i = V_i C_V(φ_i, Re_i) with the predicted
+  ///  * semi-implicit drag (E29, docs/equations.md): C_i = V_i C_V(φ_i, Re_i) with the predicted
   ///    velocities, F_d = C_i/(1 + Δt C_i (1/m_s + 1/m_f)) Δv; grains −F_d, fluid +F_d. The drag
   ///    coefficients of the block's mixture nodes are computed at once (their powers in vector
   ///    lanes).
@@ -586,7 +586,7 @@ class Solver {
   }
 
   /// Before the grid pass (on the main thread: it may talk to the other ranks): the rigid bodies'
-  /// masses (over every rank); contact (model.md §8), part 1: the node weights and measures (once;
+  /// masses (over every rank); contact (docs/contact.md), part 1: the node weights and measures (once;
   /// decomposed: 0 on the nodes another rank owns), the arrays part 2 fills, and the box of the
   /// mixture's points near the solids (part 2's scatter_mass_gradient_near).
   void prepare_rigid_and_contact() {
@@ -683,7 +683,7 @@ class Solver {
       scatter_mass_gradient_and_volume<G, K>(*bodies_[c.solid], caches_[c.solid], &c.mass_gradient, c.volume_m3);
   }
 
-  /// Contact, part 3 (after the grid pass): every pair's impulses (model.md §8, contact.hpp),
+  /// Contact, part 3 (after the grid pass): every pair's impulses (docs/contact.md, contact.hpp),
   /// then the free rigid bodies' new velocity V = V + Δt g + (Σ impulses)/M on their free
   /// components.
   void resolve_contacts() {
@@ -950,8 +950,8 @@ class Solver {
   BoundaryConditions<D> bc_{};
   std::vector<std::unique_ptr<Body<G>>> bodies_;
   std::vector<RigidMotion<G>> rigid_;      ///< per body: deformable, prescribed or free rigid
-  std::vector<ContactPair<G>> contacts_;   ///< solid–mixture contact pairs (§8)
-  std::vector<Motor<G>> motors_;           ///< angular-velocity motors (§8, wheel)
+  std::vector<ContactPair<G>> contacts_;   ///< solid–mixture contact pairs (docs/contact.md)
+  std::vector<Motor<G>> motors_;           ///< angular-velocity motors (docs/contact.md, wheel)
   std::vector<double> contact_weight_;     ///< per node: weight in the body impulse sums
   std::vector<double> node_measure_;       ///< per node: h^D (per radian h² r) for the overlap test
   std::vector<double> mixture_volume_;     ///< nodal grains volume when there is no fluid body

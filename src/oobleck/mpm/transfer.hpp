@@ -1,5 +1,5 @@
 #pragma once
-// Grid fields and the particle↔grid kernels of one body (model.md §6 steps 2, 5, 6, 7).
+// Grid fields and the particle↔grid kernels of one body (docs/mpm.md, "The step": P2G, grid, G2P).
 // Free functions over the body's arrays, the shape cache and the body's grid field, each over a
 // range of points or nodes; which thread runs which range is decided in parallel.hpp.
 //
@@ -508,8 +508,8 @@ struct G2PSums {
   }
 };
 
-/// G2P's first half for point p (grid_to_particles_kernel): the sums over its nodes (model.md §6
-/// step 6) from the nodal velocities, old velocities (FLIP), flux and porosity (mixture).
+/// G2P's first half for point p (grid_to_particles_kernel): the sums over its nodes (docs/mpm.md
+/// phase 6) from the nodal velocities, old velocities (FLIP), flux and porosity (mixture).
 template <class G, int K, bool Apic, bool ByGrad, bool Mixture, bool NoSwirl>
 #if defined(__GNUC__)
 [[gnu::always_inline]]
@@ -849,7 +849,7 @@ std::int64_t grid_to_particles_kernel(const G2PArgs<G>& args, std::int64_t block
 
 }  // namespace detail
 
-/// G2P (model.md §6 step 6): positions x ← x + Δt ∑N v_i (wrapped on periodic axes), velocities by
+/// G2P (docs/mpm.md, "The step" phase 6): positions x ← x + Δt ∑N v_i (wrapped on periodic axes), velocities by
 /// the FLIP/PIC blend v ← α (v + ∑N (v_i − v_i^old)) + (1 − α) ∑N v_i or by APIC (v ← ∑N v_i,
 /// C ← B D⁻¹, or ∑ v_i ∇Nᵀ for linear weights), and the velocity gradient L = ∑ v_i ∇Nᵀ (plus
 /// geometry terms). Also the volume update V ← V exp(Δt tr L) (step 7), fused into the same loop.

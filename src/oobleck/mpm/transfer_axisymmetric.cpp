@@ -1,4 +1,4 @@
-// The axisymmetric G2P (model.md §6 steps 6–7, §7), instantiated here alone so that CMake can
+// The axisymmetric G2P (docs/mpm.md: "The step" phase 6, "Geometry modes"), instantiated here alone so that CMake can
 // compile this unit with 128-bit auto-vectorisation (-mprefer-vector-width=128; AVX2 and FMA are
 // kept where the build or its glibc-hwcaps variant has them).
 //

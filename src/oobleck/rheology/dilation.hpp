@@ -1,5 +1,5 @@
 #pragma once
-// Structure-dependent dilation parameters, model.md E1–E2 (paper eqs. phim_func, a_func).
+// Structure-dependent dilation parameters, E1–E2 (docs/equations.md) (paper eqs. phim_func, a_func).
 #include "oobleck/rheology/params.hpp"
 
 namespace oobleck::rheology {

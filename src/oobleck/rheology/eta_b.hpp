@@ -1,5 +1,5 @@
 #pragma once
-// Resistance to buckling-induced structure loss, model.md E8 (paper eq. eta_B).
+// Resistance to buckling-induced structure loss, E8 (docs/equations.md) (paper eq. eta_B).
 #include <cmath>
 #include <limits>
 

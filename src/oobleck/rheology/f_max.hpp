@@ -1,5 +1,5 @@
 #pragma once
-// Upper bound of the steady structure, model.md E9 (paper eq. cmax).
+// Upper bound of the steady structure, E9 (docs/equations.md) (paper eq. cmax).
 #include "oobleck/rheology/params.hpp"
 
 namespace oobleck::rheology {

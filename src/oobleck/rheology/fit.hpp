@@ -1,5 +1,5 @@
 #pragma once
-// Least-squares fits of the steady-rheology asymptotes to rheometer data (model.md §2, "Fitting";
+// Least-squares fits of the steady-rheology asymptotes to rheometer data (docs/fitting.md;
 // paper SI "Fitting a_0 and phi_j", "Fitting a_inf and phi_c", "Fitting gamma_dot_DST"):
 //   low : (a_0, phi_j)            of E12 to minimum relative viscosities,
 //   high: (a_inf, phi_c)          of E13 to plateau (maximum) relative viscosities,

@@ -1,5 +1,5 @@
 #pragma once
-// Joint least-squares fit of the steady model (model.md §2, E1–E14) to whole flow curves at
+// Joint least-squares fit of the steady model (E1–E14, docs/equations.md, steady rheology) to whole flow curves at
 // several volume fractions: a chosen subset of the parameters (default a_0, phi_j, a_inf, phi_c,
 // tau_star and every eta_B term) against points (phi, shear rate, shear stress). Each point is
 // matched to the model's steady state at the same phi and the same measured stress (residual

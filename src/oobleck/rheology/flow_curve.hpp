@@ -1,6 +1,6 @@
 #pragma once
 // Steady simple-shear flow curves of the Baumgarten–Kamrin model, complete with every branch:
-// the curve is swept parametrically in the structure f (model.md E11), so S-shaped and DST
+// the curve is swept parametrically in the structure f (E11, docs/equations.md), so S-shaped and DST
 // branches are never lost by a root finder in gamma_dot or tau. Asymptotes E12–E14.
 #include <optional>
 #include <string>
@@ -25,7 +25,7 @@ struct SteadyPoint {
 /// Throws InputError unless 0 < phi < phi_j (`where` names the source of phi, e.g. "--phi").
 void validate_phi(const SteadyParams& p, double phi, const std::string& where);
 
-/// Upper end of the structure sweep: f_u = min(f_m(phi), f_jam(phi)) (model.md §2).
+/// Upper end of the structure sweep: f_u = min(f_m(phi), f_jam(phi)) (docs/equations.md, steady rheology).
 double f_upper(const SteadyParams& p, double phi);
 
 /// Steady state at structure f, where `gap` = f_u - f is given separately so that states

@@ -1,5 +1,5 @@
 #pragma once
-// Material parameters of the Baumgarten–Kamrin model, named as in ../shared/spec/model.md §1.
+// Material parameters of the Baumgarten–Kamrin model, named as in docs/equations.md.
 // Every field carries its unit. Built only through load_preset()/validate(), which check every
 // rule below; the laws themselves assume validated parameters.
 #include <string>
@@ -13,7 +13,7 @@ struct EtaBTerm {
   double alpha = 0.0;  ///< [-]
 };
 
-/// Steady-rheology parameters (paper Tables 1–3; model.md §2).
+/// Steady-rheology parameters (paper Tables 1–3; docs/equations.md, steady rheology).
 struct SteadyParams {
   double phi_c = 0.0;                 ///< [-] frictional jamming fraction (phi_c < phi_j)
   double phi_j = 0.0;                 ///< [-] frictionless jamming fraction
@@ -27,7 +27,7 @@ struct SteadyParams {
   std::vector<EtaBTerm> eta_B_terms;  ///< E8; empty means eta_B = infinity
 };
 
-/// Parameters of the time-dependent granular law (model.md §3) that the steady model does not
+/// Parameters of the time-dependent granular law (E16–E24, docs/equations.md) that the steady model does not
 /// need. Defaults: the cornstarch values of the paper's dynamic scenes.
 struct GranularParams {
   double d = 5.85e-6;   ///< [m] grain diameter

@@ -1,6 +1,6 @@
 #pragma once
 // Every steady state of homogeneous simple shear at a given shear rate or mixture shear stress
-// (model.md E11): the inverse of the flow curve, branch by branch. An S-shaped curve has up to
+// (E11, docs/equations.md): the inverse of the flow curve, branch by branch. An S-shaped curve has up to
 // three states at one rate; a DST curve none above gamma_dot_DST. Used by the Python module's
 // viscosity_at and by the joint flow-curve fit (fit_curves.hpp).
 #include <vector>

@@ -1,5 +1,5 @@
 #pragma once
-// Evolution of the micro-structure f, model.md E6, E7, E10 (paper eqs. c_model, hardening,
+// Evolution of the micro-structure f, E6, E7, E10 (docs/equations.md) (paper eqs. c_model, hardening,
 // softening, steadyf).
 #include <cmath>
 

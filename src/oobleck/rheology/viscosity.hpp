@@ -1,5 +1,5 @@
 #pragma once
-// Steady viscous-regime stresses, model.md E3–E5 (paper eqs. effective_viscosity,
+// Steady viscous-regime stresses, E3–E5 (docs/equations.md) (paper eqs. effective_viscosity,
 // normal_viscosity; mu_h from the base model). All functions take the gap phi_m - phi
 // explicitly so that callers near jamming can supply it without cancellation.
 namespace oobleck::rheology {

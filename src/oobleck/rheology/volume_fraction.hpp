@@ -1,5 +1,5 @@
 #pragma once
-// Volume fraction from mass fraction for swelling starch grains, model.md E15 (paper SI,
+// Volume fraction from mass fraction for swelling starch grains, E15 (docs/equations.md) (paper SI,
 // after Peters et al. 2016).
 namespace oobleck::rheology {
 

@@ -514,7 +514,7 @@ void read_body_material(io::TomlReader& r, const SceneConfig& c, BodyConfig& b) 
   }
 }
 
-/// One [[body]] table (model.md §8 bodies).
+/// One [[body]] table (docs/contact.md).
 BodyConfig read_body(io::TomlReader& r, std::size_t index, const SceneConfig& c) {
   const int ncomp = c.grid.geometry == Geometry::PlaneStrain ? 2 : 3;
   BodyConfig b;
@@ -557,7 +557,7 @@ BodyConfig read_body(io::TomlReader& r, std::size_t index, const SceneConfig& c)
   return b;
 }
 
-/// [[body]]: solid third bodies (model.md §8) with distinct names; needs the grid and the
+/// [[body]]: solid third bodies (docs/contact.md) with distinct names; needs the grid and the
 /// boundary (a body may cross a periodic pair of faces).
 std::vector<BodyConfig> read_bodies(io::TomlReader& top, const SceneConfig& c) {
   auto bodies = top.table_array("body");

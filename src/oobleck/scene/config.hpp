@@ -48,7 +48,7 @@ struct FluidConfig {
 
 struct CouplingConfig {
   DragLaw drag = DragLaw::Beetstra;
-  double porosity_min = 0.2;  ///< [-] lower clamp of nodal porosity n (model.md §5)
+  double porosity_min = 0.2;  ///< [-] lower clamp of nodal porosity n (E28, docs/equations.md)
 };
 
 struct TransferConfig {
@@ -74,7 +74,7 @@ struct RegionConfig {
   ElasticConfig elastic;  ///< for phase = "elastic"
 };
 
-/// Shape of a third body (model.md §8). Axisymmetric: a box touching r = 0 is a cylinder.
+/// Shape of a third body (docs/contact.md). Axisymmetric: a box touching r = 0 is a cylinder.
 enum class BodyShape { Box, Disc, Wheel, Cylinder };
 /// How a third body moves: rigid at a fixed velocity (intruder), free rigid translation under
 /// gravity and contact (rod), or elastic (wheel; optionally with a motor on its mean ω).

@@ -1,5 +1,5 @@
 #pragma once
-// Scene [[body]] entries (scene/config.hpp BodyConfig) turned into solver bodies (model.md §8):
+// Scene [[body]] entries (scene/config.hpp BodyConfig) turned into solver bodies (docs/contact.md):
 // point lattices for boxes, discs, spoked wheels and cylinders, the rigid/elastic motion, the contact pair
 // and the motor (used by scene/build.cpp; prescribed_velocity also by the run loop's ramp).
 #include <algorithm>
