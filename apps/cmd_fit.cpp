@@ -1,11 +1,13 @@
 // `oobleck rheology fit`: fit the steady asymptotes of the model to rheometer data with Ceres
-// (model.md §2 "Fitting"; library part in src/oobleck/rheology/fit.hpp):
+// (docs/equations.md, steady rheology; docs/fitting.md; library part in src/oobleck/rheology/fit.hpp):
 //   --kind low : (a_0, phi_j) of E12 to minimum viscosities      (columns phi, viscosity | relative_viscosity)
 //   --kind high: (a_inf, phi_c) of E13 to plateau viscosities     (same columns)
 //   --kind dst : eta_B terms (phi_i, alpha_i) of E8 via E14        (columns phi, shear_rate_dst)
 //   --kind curves: a joint fit to whole flow curves (rheology/fit_curves.hpp; columns phi,
 //                  shear_rate, shear_stress), or to instrument exports, one --data FILE
-//                  [--step NAME|INDEX] --phi PHI per volume fraction (io/rheometer.hpp)
+//                  [--step NAME|INDEX] --phi PHI per volume fraction (io/rheometer.hpp); parameters
+//                  the data do not determine are held at the base values with a warning (--strict:
+//                  an error)
 // Writes a complete parameter file (the base set with the fitted values replaced, standard errors
 // as comments) that loads with --params in every other command.
 #include <algorithm>
@@ -181,7 +183,8 @@ std::string plot_fit(const rheology::FitResult& r, const Data& d, const std::str
 struct CurvesOpts {
   std::string data, out, parameters, residual, png;  ///< data: the file(s), ", "-separated
   bool json = false;
-  std::string args;  ///< the exports' --data/--step/--phi options ("" for one CSV)
+  bool strict = false;  ///< undetermined parameters are an error instead of held
+  std::string args;     ///< the exports' --data/--step/--phi options ("" for one CSV)
   /// The data files' names without folders, ", "-separated.
   std::string names() const {
     std::string n, item;
@@ -312,6 +315,12 @@ std::string plot_curves_fit(const rheology::CurvesFitResult& r, const io::CsvTab
   return tmp;
 }
 
+std::string held_names(const rheology::CurvesFitResult& r) {
+  std::vector<std::string> names;
+  for (const auto& p : r.held) names.push_back(p.name);
+  return fmt::format("{}", fmt::join(names, ", "));
+}
+
 void fit_curves_command(const CurvesOpts& o, const io::CsvTable& t, rheology::Preset preset, const std::string& note) {
   for (const char* c : {"phi", "shear_rate", "shear_stress"}) {
     if (!t.has_column(c)) {
@@ -324,6 +333,7 @@ void fit_curves_command(const CurvesOpts& o, const io::CsvTable& t, rheology::Pr
   rheology::CurvesFitOptions options;
   options.where = o.data;
   options.residual = rheology::parse_curves_residual(o.residual, "--residual");
+  options.strict = o.strict;
   if (!o.parameters.empty()) {
     std::string item;
     for (char c : o.parameters + ",") {
@@ -354,7 +364,22 @@ void fit_curves_command(const CurvesOpts& o, const io::CsvTable& t, rheology::Pr
   for (const auto& p : r.parameters) {
     h += fmt::format("#   {} = {:.8g} +- {} {}\n", p.name, p.value, fmt_se(p.std_error), unit_of(p.name));
   }
+  if (!r.held.empty()) {
+    h += "# held at the base set's values because the data do not determine them (--strict: an error instead):\n";
+    for (const auto& p : r.held) {
+      h += fmt::format("#   {} = {:.8g} {}: {}\n", p.name, p.value, unit_of(p.name), sanitize(p.reason));
+    }
+  }
   h += fmt::format("# n = {} points, p = {} parameters, rms log residual = {:.4g}\n\n", r.n, r.p, r.rms);
+  // The warning goes to stderr in both output modes, before anything is written.
+  for (const auto& p : r.held) {
+    fmt::print(stderr, "warning: {} held at the base value {:.6g} {}: the data do not determine it ({})\n", p.name,
+               p.value, unit_of(p.name), p.reason);
+  }
+  if (!r.held.empty()) {
+    fmt::print(stderr, "warning: {} of {} parameters held ({}); --strict makes this an error\n", r.held.size(),
+               r.held.size() + r.parameters.size(), held_names(r));
+  }
   std::string tmp_png;
   if (!o.png.empty()) {
     tmp_png = plot_curves_fit(r, t, options.residual,
@@ -382,6 +407,9 @@ void fit_curves_command(const CurvesOpts& o, const io::CsvTable& t, rheology::Pr
                         {"out", o.out},
                         {"residual", rheology::to_string(options.residual)},
                         {"correlation", r.correlation}};
+    nlohmann::json held = nlohmann::json::array();
+    for (const auto& p : r.held) held.push_back({{"name", p.name}, {"value", p.value}, {"reason", p.reason}});
+    j["held"] = held;
     if (!note.empty()) j["note"] = note;
     fmt::print("{}\n", j.dump());
     return;
@@ -395,6 +423,9 @@ void fit_curves_command(const CurvesOpts& o, const io::CsvTable& t, rheology::Pr
     const double rel = std::abs(p.std_error / p.value);
     fmt::print("  {:<{}} = {:<12.6g} +- {:<10}  {:<11}{}\n", p.name, width, p.value, fmt_se(p.std_error),
                unit_of(p.name), std::isfinite(rel) ? fmt::format("({:.2g} %)", 100.0 * rel) : "");
+  }
+  for (const auto& p : r.held) {
+    fmt::print("  {:<{}} = {:<12.6g} held (base value)  {}\n", p.name, width, p.value, unit_of(p.name));
   }
   fmt::print("rms log residual = {:.4g} (n = {}, residual: ln {})\n", r.rms, r.n,
              rheology::to_string(options.residual));
@@ -415,7 +446,7 @@ void add_fit_command(CLI::App& rheology) {
     std::vector<std::string> files, steps;
     std::vector<double> phi;
     int terms = 0;
-    bool json = false;
+    bool json = false, strict = false;
     std::string parameters, residual = "rate";
   };
   auto o = std::make_shared<Opts>();
@@ -446,7 +477,10 @@ void add_fit_command(CLI::App& rheology) {
   auto* residual = cmd->add_option("--residual", o->residual,
                                    "curves only: rate (ln shear rate at the measured stress) or stress (ln shear "
                                    "stress at the measured rate)");
-  cmd->callback([o, cmd, data, phi, step, terms, parameters, residual] {
+  auto* strict = cmd->add_flag("--strict", o->strict,
+                               "curves only: a parameter the data do not determine is an error (default: it is held "
+                               "at the base set's value, with a warning naming it)");
+  cmd->callback([o, cmd, data, phi, step, terms, parameters, residual, strict] {
     if (o->kind != "low" && o->kind != "high" && o->kind != "dst" && o->kind != "curves") {
       throw InputError(
           fmt::format("--kind = '{}': must be one of low (a_0, phi_j from minimum viscosities, E12), high (a_inf, "
@@ -498,10 +532,11 @@ void add_fit_command(CLI::App& rheology) {
       }
       const rheology::Preset base = o->params.load(kDefaultPreset);
       const io::CsvTable table = curves_table(exports, o->data, o->json);
-      fit_curves_command({o->data, o->out, o->parameters, o->residual, o->png, o->json, args}, table, base, note);
+      fit_curves_command({o->data, o->out, o->parameters, o->residual, o->png, o->json, o->strict, args}, table, base,
+                         note);
       return;
     }
-    for (auto* opt : {parameters, residual}) {
+    for (auto* opt : {parameters, residual, strict}) {
       if (opt->count() > 0)
         throw InputError(fmt::format("{}: only for --kind curves (not {})", opt->get_name(), o->kind));
     }

@@ -1,4 +1,4 @@
-// `oobleck rheology ...`: steady rheology of the model (model.md §2): flow curves with every
+// `oobleck rheology ...`: steady rheology of the model (docs/equations.md, steady rheology): flow curves with every
 // branch, the DST shear rate, the f(tau) comparison, the mass-to-volume fraction conversion, and
 // `import`: a rheometer's export file as one CSV in SI (io/rheometer.hpp).
 #include <algorithm>

@@ -392,7 +392,9 @@ class FitResult:
     in the parameters' units; NaN where not identifiable); ``correlation`` (DataFrame, fitted
     parameters x fitted parameters); ``residuals`` (DataFrame: the data, the model's value and the
     log residual ln(model) − ln(data) per point); ``n``, ``p``, ``rms`` (RMS log residual),
-    ``cost``, ``iterations``.
+    ``cost``, ``iterations``; ``held``: a list of ``(name, reason)`` tuples, the requested
+    parameters the data do not determine, held at the base set's values (their values are in
+    ``params``; 'curves' only, empty otherwise and with ``strict=True``).
     """
 
     def __init__(self, kind, raw, data, base):
@@ -405,6 +407,7 @@ class FitResult:
         self.stderr = {n: s for n, _, s in raw["parameters"]}
         self.n, self.p, self.rms = raw["n"], raw["p"], raw["rms"]
         self.cost, self.iterations = raw["cost"], raw["iterations"]
+        self.held = [(name, reason) for name, _, reason in raw.get("held", [])]
         if "correlation" in raw:
             corr = raw["correlation"]
             self.covariance = pd.DataFrame(raw["covariance"], index=names, columns=names)
@@ -424,6 +427,8 @@ class FitResult:
         lines = [f"FitResult(kind={self.kind!r}, n={self.n}, p={self.p}, rms={self.rms:.4g})"]
         for k, v in self.values.items():
             lines.append(f"  {k:<16} = {v:<14.6g} +- {self.stderr[k]:.3g}")
+        for k, reason in self.held:
+            lines.append(f"  {k:<16} held at the base value ({reason})")
         return "\n".join(lines)
 
     def plot(self, ax=None):
@@ -463,7 +468,7 @@ class FitResult:
 
 
 def fit(kind: str, data, params=None, *, terms=None, parameters=None, residual: str = "rate", bounds=None, phi=None,
-        step=None):
+        step=None, strict: bool = False):
     """Least-squares fit (Ceres) of the model to rheometer data; returns a :class:`FitResult`.
 
     kind: 'low' (a_0, phi_j; E12), 'high' (a_inf, phi_c; E13), 'dst' (eta_B terms; E14) exactly as
@@ -485,7 +490,12 @@ def fit(kind: str, data, params=None, *, terms=None, parameters=None, residual: 
       :func:`read_rheometer`), phi their volume fractions (a number or a list as long), step the
       step of each (a name or 1-based index, one for all or a list; default: the file's one step
       with shear rate and stress).
-    A parameter the data do not determine raises InputError naming it.
+    strict: curves only. False (default): a parameter the data do not determine (the residuals do
+      not change with it, a rank-deficient Jacobian, or a 1-sigma range wider than a factor 1000,
+      +-0.1 in phi, +-10 in alpha) is held at the base set's value and the fit redone without it,
+      one at a time; ``FitResult.held`` lists them with the reason and a UserWarning names them.
+      True: such a parameter raises InputError naming it. Every parameter undetermined is always
+      an InputError.
     """
     if not isinstance(kind, str) or kind not in ("low", "high", "dst", "curves"):
         raise InputError(f"kind = {kind!r}: must be one of 'low', 'high', 'dst', 'curves'")
@@ -512,6 +522,8 @@ def fit(kind: str, data, params=None, *, terms=None, parameters=None, residual: 
                 raise InputError(f"{arg}: only for kind 'curves' (not {kind!r})")
         if residual != "rate":
             raise InputError(f"residual: only for kind 'curves' (not {kind!r})")
+        if strict is not False:
+            raise InputError(f"strict: only for kind 'curves' (not {kind!r})")
         if terms is not None and kind != "dst":
             raise InputError(f"terms = {terms!r}: only for kind 'dst' (not {kind!r})")
         n_terms = 0 if terms is None else _integer(terms, "terms")
@@ -565,7 +577,15 @@ def fit(kind: str, data, params=None, *, terms=None, parameters=None, residual: 
             lo = -math.inf if lo is None else _number(lo, f"bounds[{name!r}][0]")
             hi = math.inf if hi is None else _number(hi, f"bounds[{name!r}][1]")
             blist.append((str(name), lo, hi))
-    raw = _core.fit_curves(phi, rate, stress, base, names, residual, blist, where)
+    if not isinstance(strict, bool):
+        raise InputError(f"strict = {strict!r}: must be True or False")
+    raw = _core.fit_curves(phi, rate, stress, base, names, residual, blist, where, strict)
+    if raw["held"]:
+        import warnings
+        held = "; ".join(f"{name} = {value:.6g} ({reason})" for name, value, reason in raw["held"])
+        warnings.warn(f"oobleck.fit('curves'): {len(raw['held'])} of {len(raw['held']) + raw['p']} parameters held "
+                      f"at the base set's values because the data do not determine them: {held} "
+                      f"(strict=True makes this an error)", UserWarning, stacklevel=2)
     table = _frame({"phi": phi, "shear_rate": rate, "shear_stress": stress}, ("phi", "shear_rate", "shear_stress"))
     return FitResult("curves", raw, table, base)
 

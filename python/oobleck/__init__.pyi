@@ -56,7 +56,9 @@ class FitResult:
     rms: float
     cost: float
     iterations: int
-    def plot(self, ax: Any = None) -> Any: ...
+    held: list[tuple[str, str]]
+    def plot(self, ax: Any = None, y: Literal["stress", "viscosity"] = "stress",
+             x: Literal["rate", "stress"] = "rate") -> Any: ...
 
 class Frame:
     path: str
@@ -94,7 +96,8 @@ def fit(kind: str, data: Union[pd.DataFrame, str, os.PathLike, Sequence[Union[st
         params: Optional[ParamsLike] = None, *,
         terms: Optional[int] = None, parameters: Optional[Sequence[str]] = None, residual: str = "rate",
         bounds: Optional[dict[str, tuple[Optional[float], Optional[float]]]] = None,
-        phi: Optional[Numbers] = None, step: Optional[Union[str, int, list]] = None) -> FitResult: ...
+        phi: Optional[Numbers] = None, step: Optional[Union[str, int, list]] = None,
+        strict: bool = False) -> FitResult: ...
 RHEOMETER_COLUMNS: tuple[str, ...]
 def read_rheometer(path: Union[str, os.PathLike], format: str = "auto", *,
                    step: Optional[Union[str, int]] = None) -> pd.DataFrame: ...

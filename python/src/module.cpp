@@ -245,8 +245,10 @@ double fit_model_value(const std::string& kind, const rheology::Preset& p, doubl
 
 py::dict fit_curves(const std::vector<double>& phi, const std::vector<double>& rate, const std::vector<double>& stress,
                     const rheology::Preset& base, const std::vector<std::string>& names, const std::string& residual,
-                    const std::vector<std::tuple<std::string, double, double>>& bounds, const std::string& where) {
+                    const std::vector<std::tuple<std::string, double, double>>& bounds, const std::string& where,
+                    bool strict) {
   rheology::CurvesFitOptions o;
+  o.strict = strict;
   o.parameters = names;
   o.residual = rheology::parse_curves_residual(residual, "residual");
   for (const auto& [name, lo, hi] : bounds) o.bounds.push_back({name, lo, hi});
@@ -279,6 +281,9 @@ py::dict fit_curves(const std::vector<double>& phi, const std::vector<double>& r
   d["cost"] = r.cost;
   d["iterations"] = r.iterations;
   d["residual"] = rheology::to_string(o.residual);
+  py::list held;
+  for (const auto& h : r.held) held.append(py::make_tuple(h.name, h.value, h.reason));
+  d["held"] = held;
   return d;
 }
 
@@ -602,8 +607,9 @@ PYBIND11_MODULE(_oobleck, m) {
   m.def("load_params_file", &rheology::load_params_file, py::arg("path"));
 
   py::class_<rheology::Preset> params(m, "Params",
-                                      "A complete parameter set (a preset file): steady model (model.md §2) and "
-                                      "granular law (§3). Every assignment is validated (oobleck.InputError).");
+                                      "A complete parameter set (a preset file): steady model (docs/equations.md, "
+                                      "steady rheology) and granular law (docs/equations.md, time-dependent granular "
+                                      "law). Every assignment is validated (oobleck.InputError).");
   params.def(py::init([](const rheology::Preset& p) { return p; }), py::arg("other"), "a copy");
   params.def_readwrite("name", &rheology::Preset::name, "name of the set (str)");
   params.def_readwrite("source", &rheology::Preset::source, "literature source (str)");
@@ -687,7 +693,7 @@ PYBIND11_MODULE(_oobleck, m) {
         py::arg("terms"), py::arg("where"));
   m.def("fit_model_value", &fit_model_value, py::arg("kind"), py::arg("params"), py::arg("phi"));
   m.def("fit_curves", &fit_curves, py::arg("phi"), py::arg("shear_rate"), py::arg("shear_stress"), py::arg("base"),
-        py::arg("parameters"), py::arg("residual"), py::arg("bounds"), py::arg("where"));
+        py::arg("parameters"), py::arg("residual"), py::arg("bounds"), py::arg("where"), py::arg("strict") = false);
   m.def("curves_default_parameters", &rheology::curves_default_parameters, py::arg("base"));
   m.def("read_rheometer", &read_rheometer, py::arg("path"), py::arg("format"), py::arg("step"));
   m.def("rheometer_flow_curve", &rheometer_flow_curve, py::arg("path"), py::arg("step"));

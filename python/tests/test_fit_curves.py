@@ -1,6 +1,8 @@
 """The joint curves fit recovers the parameters of a preset from synthetic flow curves (3 %
 log-normal noise on the rate at each stress) within 2 standard errors, with larger errors from
-fewer volume fractions, and refuses data that cannot determine a parameter."""
+fewer volume fractions; a parameter the data do not determine is held at the base value with a
+warning (strict=True: an error); a first call with the defaults on rate-controlled curves below
+DST succeeds."""
 import numpy as np
 import pandas as pd
 import pytest
@@ -76,17 +78,79 @@ def test_residual_in_log_stress_at_measured_rate():
         assert r.values[name] == pytest.approx(true_value(truth, name), rel=1e-2)
 
 
-def test_undetermined_parameter_is_an_error():
+def test_undetermined_parameter_is_an_error_when_strict():
     truth = oobleck.load_params("hermes2016")
     below = [0.30, 0.34, 0.38, 0.42]  # all below phi_c = 0.436
     low_stress = synthetic(truth, below, stresses=np.geomspace(1e-3, 3e-2, 10))
     with pytest.raises(oobleck.InputError, match=r"do not determine phi_c"):
-        oobleck.fit("curves", low_stress, start_from(truth), parameters=["a_0", "phi_j", "phi_c"])
+        oobleck.fit("curves", low_stress, start_from(truth), parameters=["a_0", "phi_j", "phi_c"], strict=True)
     with pytest.raises(oobleck.InputError, match=r"do not determine a_inf"):
-        oobleck.fit("curves", low_stress, start_from(truth))
+        oobleck.fit("curves", low_stress, start_from(truth), strict=True)
     # up to high stresses phi_c is determined by the thickened plateau (as fit --kind high), eta_B is not
     with pytest.raises(oobleck.InputError, match=r"do not determine eta_B\[0\]"):
-        oobleck.fit("curves", synthetic(truth, below), start_from(truth))
+        oobleck.fit("curves", synthetic(truth, below), start_from(truth), strict=True)
+
+
+def test_undetermined_parameter_is_held_with_a_warning():
+    truth = oobleck.load_params("hermes2016")
+    below = [0.30, 0.34, 0.38, 0.42]
+    low_stress = synthetic(truth, below, stresses=np.geomspace(1e-3, 3e-2, 10))
+    start = start_from(truth)
+    with pytest.warns(UserWarning, match=r"phi_c = 0\.43164 \(1 sigma: \+- [0-9.]+, beyond \+- 0\.1\)"):
+        r = oobleck.fit("curves", low_stress, start, parameters=["a_0", "phi_j", "phi_c"])
+    assert [name for name, _ in r.held] == ["phi_c"]
+    assert r.params.phi_c == start.phi_c  # held at the base set's value
+    assert set(r.values) == {"a_0", "phi_j"} and r.p == 2
+    for name in r.values:  # the low-stress branch alone gives a_0 and phi_j (E12)
+        assert abs(r.values[name] - true_value(truth, name)) < 3 * r.stderr[name], name
+    # the thickened plateau below phi_c determines a_inf and phi_c, not the eta_B terms
+    with pytest.warns(UserWarning, match=r"eta_B\[0\]"):
+        r = oobleck.fit("curves", synthetic(truth, below), start)
+    assert {name for name, _ in r.held} >= {"eta_B[0].phi_i"}
+    assert all(name.startswith("eta_B[") for name, _ in r.held)
+    # nothing left to fit: the error, whatever strict says
+    with pytest.raises(oobleck.InputError, match=r"do not determine phi_c"):
+        oobleck.fit("curves", low_stress, start, parameters=["phi_c"])
+    with pytest.raises(oobleck.InputError, match=r"strict = 'yes'"):
+        oobleck.fit("curves", low_stress, start, strict="yes")
+    with pytest.raises(oobleck.InputError, match=r"strict: only for kind 'curves'"):
+        oobleck.fit("low", pd.DataFrame({"phi": [0.3, 0.4, 0.5], "relative_viscosity": [3, 6, 20]}), strict=True)
+
+
+def rate_controlled_below_dst(p, noise=0.02, seed=1):
+    """Rate-controlled flow curves at five phi from 0.40 to 0.49: 12 rates per curve, log-spaced from
+    1e-3 1/s to 0.8 gamma_dot_DST (10 1/s where there is no DST), the stress of the low-viscosity
+    branch times exp(N(0, noise))."""
+    rng = np.random.default_rng(seed)
+    rows = []
+    for phi in np.linspace(0.40, 0.49, 5):
+        dst = oobleck.shear_rate_dst(p, phi)
+        rates = np.geomspace(1e-3, 0.8 * dst if dst else 10.0, 12)
+        tau = rates * oobleck.viscosity_at(p, phi, shear_rate=rates)[:, 0]
+        rows += [(phi, g, t * np.exp(rng.normal(0.0, noise))) for g, t in zip(rates, tau)]
+    return pd.DataFrame(rows, columns=["phi", "shear_rate", "shear_stress"])
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_first_fit_with_defaults_succeeds_below_dst(seed):
+    """fit('curves', data) with every default (base hermes2016, which is the truth here) holds the
+    eta_B terms the data do not determine and recovers the rest within 3 standard errors."""
+    truth = oobleck.load_params("hermes2016")
+    data = rate_controlled_below_dst(truth, seed=seed)
+    with pytest.warns(UserWarning, match=r"held at the base set's values.*eta_B\[1\]\.phi_i = 0\.0093"):
+        r = oobleck.fit("curves", data)
+    held = [name for name, _ in r.held]
+    assert {"eta_B[1].phi_i", "eta_B[1].alpha"} <= set(held)
+    assert all(name.startswith("eta_B[") and reason for name, reason in r.held)
+    assert len(held) + r.p == 9 and set(held).isdisjoint(r.values)
+    for name in held:
+        assert true_value(r.params, name) == true_value(truth, name)
+    for name in ("a_0", "phi_j", "phi_c", "tau_star", "a_inf"):
+        z = (r.values[name] - true_value(truth, name)) / r.stderr[name]
+        assert abs(z) < 3.0, f"{name} = {r.values[name]} +- {r.stderr[name]}, z = {z:.2f}"
+    assert 0.01 < r.rms < 0.03
+    with pytest.raises(oobleck.InputError, match=r"do not determine .*eta_B\[1\]\.phi_i"):
+        oobleck.fit("curves", data, strict=True)
 
 
 def test_plot():

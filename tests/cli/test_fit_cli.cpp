@@ -16,6 +16,7 @@
 
 #include "oobleck/rheology/flow_curve.hpp"
 #include "oobleck/rheology/params.hpp"
+#include "oobleck/rheology/steady_states.hpp"
 
 namespace {
 namespace fs = std::filesystem;
@@ -227,6 +228,66 @@ TEST_F(FitCli, CurvesFitWithPlot) {
   for (const auto& e : fs::directory_iterator(dir_)) {  // no temporaries left behind
     EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << e.path();
   }
+}
+
+TEST_F(FitCli, CurvesFitHoldsWhatTheDataDoNotDetermineWithAWarning) {
+  // Rate-controlled hermes2016 curves below DST (12 rates per phi up to 0.8 gamma_dot_DST, 2 %
+  // deterministic scatter on the stress): the second eta_B term (alpha = 0.1) is not determined.
+  const auto p = oobleck::rheology::load_preset("hermes2016").steady;
+  std::string csv = "phi,shear_rate,shear_stress\n";
+  int k = 0;
+  for (double phi : {0.40, 0.4225, 0.445, 0.4675, 0.49}) {
+    const auto dst = oobleck::rheology::shear_rate_dst(p, phi);
+    const double hi = dst ? 0.8 * *dst : 10.0;
+    for (int i = 0; i < 12; ++i, ++k) {
+      const double rate = 1e-3 * std::pow(hi / 1e-3, i / 11.0);
+      const auto s = oobleck::rheology::steady_states_at(p, phi, oobleck::rheology::Control::shear_rate, rate);
+      csv += fmt(phi) + "," + fmt(rate) + "," + fmt(s.at(0).shear_stress * (1.0 + 0.02 * std::sin(5.0 * k))) + "\n";
+    }
+  }
+  write("curves.csv", csv);
+  const std::string args =
+      "rheology fit --kind curves --data " + path("curves.csv") + " --preset hermes2016 --out " + path("fit.toml");
+  ASSERT_EQ(run(args), 0) << read("err.txt");
+  const std::string err = read("err.txt"), toml = read("fit.toml"), out = read("out.txt");
+  EXPECT_NE(
+      err.find("warning: eta_B[1].phi_i held at the base value 0.0093 [1/(Pa s)]: the data do not determine it ("),
+      std::string::npos)
+      << err;
+  EXPECT_NE(out.find("  eta_B[1].phi_i = 0.0093       held (base value)"), std::string::npos) << out;
+  EXPECT_NE(err.find("parameters held (eta_B[1].phi_i"), std::string::npos) << err;
+  EXPECT_NE(err.find("--strict makes this an error"), std::string::npos) << err;
+  EXPECT_NE(toml.find("# held at the base set's values because the data do not determine them"), std::string::npos)
+      << toml;
+  EXPECT_NE(toml.find("#   eta_B[1].phi_i = 0.0093 [1/(Pa s)]: 1 sigma: a factor "), std::string::npos) << toml;
+  const auto fitted = oobleck::rheology::load_params_file(path("fit.toml"));
+  EXPECT_EQ(fitted.steady.eta_B_terms.at(1).phi_i, p.eta_B_terms.at(1).phi_i);
+
+  ASSERT_EQ(run(args + " --json"), 0) << read("err.txt");
+  const auto j = nlohmann::json::parse(read("out.txt"));
+  ASSERT_GE(j["held"].size(), 1u);
+  EXPECT_EQ(j["held"][0]["name"], "eta_B[1].phi_i");
+  EXPECT_EQ(j["held"][0]["value"].get<double>(), p.eta_B_terms.at(1).phi_i);
+  EXPECT_NE(j["held"][0]["reason"].get<std::string>().find("1 sigma: a factor"), std::string::npos);
+  EXPECT_EQ(j["parameters"].size() + j["held"].size(), 9u);
+  for (const auto& h : j["held"]) EXPECT_EQ(h["name"].get<std::string>().rfind("eta_B[", 0), 0u) << h;
+  const std::pair<const char*, double> truth[] = {
+      {"a_0", p.a_0}, {"phi_j", p.phi_j}, {"phi_c", p.phi_c}, {"tau_star", p.tau_star}};
+  for (const auto& [name, value] : truth) {
+    const auto& q = j["parameters"][name];
+    EXPECT_LT(std::fabs(q["value"].get<double>() - value), 3.0 * q["std_error"].get<double>()) << name << q;
+  }
+
+  // --strict: today's error, and no output.
+  fs::remove(path("fit.toml"));
+  EXPECT_EQ(run(args + " --strict"), 2);
+  EXPECT_NE(read("err.txt").find("the data do not determine"), std::string::npos) << read("err.txt");
+  EXPECT_FALSE(fs::exists(path("fit.toml")));
+  write("low.csv", low_csv());
+  EXPECT_EQ(run("rheology fit --kind low --data " + path("low.csv") + " --preset hermes2016 --strict --out " +
+                path("fit.toml")),
+            2);
+  EXPECT_NE(read("err.txt").find("--strict: only for --kind curves"), std::string::npos) << read("err.txt");
 }
 
 }  // namespace

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <optional>
+#include <utility>
 
 #include <Eigen/Dense>
 #include <ceres/ceres.h>
@@ -213,13 +215,26 @@ void validate_curves_data(const std::vector<double>& phi, const std::vector<doub
   }
 }
 
-CurvesFitResult fit_curves(const std::vector<double>& phi, const std::vector<double>& shear_rate,
-                           const std::vector<double>& shear_stress, const Preset& base,
-                           const CurvesFitOptions& options) {
+namespace {
+
+/// Why one attempt left parameters undetermined: the message today's error gives, and which
+/// parameters a non-strict fit holds (in the order they are held), each with its reason.
+struct Undetermined {
+  std::string message;
+  std::vector<HeldParameter> hold;
+};
+
+/// One fit of the parameters `names` (the others at the base set's values): the result, or what
+/// the data do not determine.
+struct Attempt {
+  CurvesFitResult result;
+  std::optional<Undetermined> undetermined;
+};
+
+Attempt attempt_fit(const std::vector<double>& phi, const std::vector<double>& shear_rate,
+                    const std::vector<double>& shear_stress, const Preset& base, const CurvesFitOptions& options,
+                    const std::vector<std::string>& names) {
   const std::string& w = options.where;
-  validate_curves_data(phi, shear_rate, shear_stress, base, options);
-  const std::vector<std::string> names =
-      options.parameters.empty() ? curves_default_parameters(base) : options.parameters;
   std::vector<Param> params;
   for (const auto& n : names) {
     for (const auto& q : params) {
@@ -346,9 +361,16 @@ CurvesFitResult fit_curves(const std::vector<double>& phi, const std::vector<dou
   }
   ceres::Solver::Summary summary;
   ceres::Solve(detail::levenberg_marquardt(options.max_iterations, 1e-10, 1e-10), &problem, &summary);
-  detail::require_convergence(summary, w, "curves", "start from a base set closer to the data or fit fewer parameters");
+  // A fit that does not converge is diagnosed first: an undetermined parameter that wanders is the
+  // usual reason (named, or held so that the rest converge).
+  const char* convergence_hint = "start from a base set closer to the data or fit fewer parameters";
+  const bool converged = summary.termination_type == ceres::CONVERGENCE && std::isfinite(summary.final_cost);
+  if (!std::isfinite(summary.final_cost)) {
+    detail::require_convergence(summary, w, "curves", convergence_hint);
+  }
 
-  CurvesFitResult res;
+  Attempt out;
+  CurvesFitResult& res = out.result;
   res.n = n;
   res.p = static_cast<int>(P);
   res.cost = summary.final_cost;
@@ -375,17 +397,24 @@ CurvesFitResult fit_curves(const std::vector<double>& phi, const std::vector<dou
   }
   Eigen::VectorXd scale(static_cast<Eigen::Index>(P));
   std::vector<std::string> flat;
+  std::vector<HeldParameter> flat_held;
   for (std::size_t i = 0; i < P; ++i) {
     const double norm = J.col(static_cast<Eigen::Index>(i)).norm();
-    if (!(norm > 0.0)) flat.push_back(params[i].name);
+    if (!(norm > 0.0)) {
+      flat.push_back(params[i].name);
+      flat_held.push_back({params[i].name, slot(start, params[i]), "the residuals do not change with it"});
+    }
     scale(static_cast<Eigen::Index>(i)) = norm > 0.0 ? 1.0 / norm : 1.0;
   }
   const std::string hint =
       "fix it (leave it out of the fitted parameters, keeping the base value) or add data that depend on it (e.g. "
       "points above phi_c and above tau_star for phi_c, a_inf and eta_B; low-stress points for a_0 and phi_j)";
   if (!flat.empty()) {
-    throw InputError(fmt::format("{}: the data do not determine {} (the residuals do not change with {}); {}", w,
-                                 fmt::join(flat, ", "), flat.size() == 1 ? "it" : "them", hint));
+    out.undetermined =
+        Undetermined{fmt::format("{}: the data do not determine {} (the residuals do not change with {}); {}", w,
+                                 fmt::join(flat, ", "), flat.size() == 1 ? "it" : "them", hint),
+                     flat_held};
+    return out;
   }
   const Eigen::MatrixXd Js = J * scale.asDiagonal();
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(Js, Eigen::ComputeThinV);
@@ -394,14 +423,23 @@ CurvesFitResult fit_curves(const std::vector<double>& phi, const std::vector<dou
   if (!(sv(last) > kCondition * sv(0))) {
     const Eigen::VectorXd v = svd.matrixV().col(last);
     std::vector<std::string> involved;
+    Eigen::Index largest = 0;
     for (std::size_t i = 0; i < P; ++i) {
-      if (std::fabs(v(static_cast<Eigen::Index>(i))) > 0.25) involved.push_back(params[i].name);
+      const auto ii = static_cast<Eigen::Index>(i);
+      if (std::fabs(v(ii)) > 0.25) involved.push_back(params[i].name);
+      if (std::fabs(v(ii)) > std::fabs(v(largest))) largest = ii;
     }
-    throw InputError(fmt::format(
-        "{}: the data do not determine {} (the Jacobian is rank-deficient: a combination of {} leaves every "
-        "residual unchanged; condition {:.2g}); {}",
-        w, fmt::join(involved, ", "), involved.size() == 1 ? "this parameter" : "these parameters", sv(0) / sv(last),
-        hint));
+    const std::string why = fmt::format(
+        "the Jacobian is rank-deficient: a combination of {} leaves every residual unchanged; condition {:.2g}",
+        fmt::join(involved, ", "), sv(0) / sv(last));
+    out.undetermined = Undetermined{
+        fmt::format("{}: the data do not determine {} (the Jacobian is rank-deficient: a combination of {} leaves "
+                    "every residual unchanged; condition {:.2g}); {}",
+                    w, fmt::join(involved, ", "), involved.size() == 1 ? "this parameter" : "these parameters",
+                    sv(0) / sv(last), hint),
+        {{params[static_cast<std::size_t>(largest)].name, slot(start, params[static_cast<std::size_t>(largest)]),
+          why}}};
+    return out;
   }
   // Covariance of the internal parameters: D V S^-2 V^T D s^2, then to natural units.
   const double s2 = n > res.p ? 2.0 * res.cost / (n - res.p) : 0.0;
@@ -418,6 +456,8 @@ CurvesFitResult fit_curves(const std::vector<double>& phi, const std::vector<dou
   // Determined, but so loosely that the value means nothing: a 1-sigma range wider than a factor
   // of 1000 for the positive scales, 0.1 for a volume fraction, 10 for an exponent, 1 for Delta.
   std::vector<std::string> loose;
+  double loosest = 0.0;
+  HeldParameter loosest_held;
   for (std::size_t i = 0; i < P; ++i) {
     const double se = std::sqrt(cov(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)));
     const Param& q = params[i];
@@ -426,13 +466,24 @@ CurvesFitResult fit_curves(const std::vector<double>& phi, const std::vector<dou
                          : q.field == Param::Delta ? 1.0
                                                    : 0.1;
     if (!(se <= limit)) {
-      loose.push_back(q.log ? fmt::format("{} (1 sigma: a factor {:.3g})", q.name, std::exp(std::min(se, 700.0)))
-                            : fmt::format("{} (1 sigma: +- {:.3g})", q.name, se));
+      const std::string range = q.log ? fmt::format("1 sigma: a factor {:.3g}", std::exp(std::min(se, 700.0)))
+                                      : fmt::format("1 sigma: +- {:.3g}", se);
+      loose.push_back(fmt::format("{} ({})", q.name, range));
+      const double ratio = std::isnan(se) ? kInf : se / limit;
+      if (loosest_held.name.empty() || ratio > loosest) {
+        loosest = ratio;
+        loosest_held = {
+            q.name, slot(start, q),
+            fmt::format("{}, beyond {}", range, q.log ? std::string("a factor 1000") : fmt::format("+- {:g}", limit))};
+      }
     }
   }
   if (!loose.empty()) {
-    throw InputError(fmt::format("{}: the data do not determine {}; {}", w, fmt::join(loose, ", "), hint));
+    out.undetermined = Undetermined{
+        fmt::format("{}: the data do not determine {}; {}", w, fmt::join(loose, ", "), hint), {loosest_held}};
+    return out;
   }
+  if (!converged) detail::require_convergence(summary, w, "curves", convergence_hint);
   cov = dq.asDiagonal() * cov * dq.asDiagonal();
   res.covariance.resize(P * P);
   res.correlation.resize(P * P);
@@ -450,7 +501,36 @@ CurvesFitResult fit_curves(const std::vector<double>& phi, const std::vector<dou
   } catch (const InputError& e) {
     throw NumericalError(fmt::format("the fitted parameters break a rule: {}", e.what()));
   }
-  return res;
+  return out;
+}
+
+}  // namespace
+
+CurvesFitResult fit_curves(const std::vector<double>& phi, const std::vector<double>& shear_rate,
+                           const std::vector<double>& shear_stress, const Preset& base,
+                           const CurvesFitOptions& options) {
+  validate_curves_data(phi, shear_rate, shear_stress, base, options);
+  std::vector<std::string> names = options.parameters.empty() ? curves_default_parameters(base) : options.parameters;
+  std::vector<HeldParameter> held;
+  std::string first_message;  // today's error: what the first fit, of every requested parameter, leaves undetermined
+  CurvesFitOptions active = options;
+  for (;;) {
+    Attempt a = attempt_fit(phi, shear_rate, shear_stress, base, active, names);
+    if (!a.undetermined) {
+      a.result.held = held;
+      return std::move(a.result);
+    }
+    const Undetermined& u = *a.undetermined;
+    if (first_message.empty()) first_message = u.message;
+    // Strict, or nothing would be left to fit: the error.
+    if (options.strict || u.hold.size() >= names.size()) throw InputError(first_message);
+    for (const HeldParameter& h : u.hold) {
+      names.erase(std::find(names.begin(), names.end(), h.name));
+      auto& b = active.bounds;
+      b.erase(std::remove_if(b.begin(), b.end(), [&](const ParameterBounds& x) { return x.name == h.name; }), b.end());
+      held.push_back(h);
+    }
+  }
 }
 
 }  // namespace oobleck::rheology

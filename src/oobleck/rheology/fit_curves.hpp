@@ -8,8 +8,11 @@
 // ln tau_model - ln tau_data, the nearest branch where an S-shaped curve has several).
 // Solved with Ceres (Levenberg–Marquardt with bounds, central-difference Jacobians of the
 // library's own steady states: no second implementation of the laws). Standard errors and the
-// correlation matrix from (J^T J)^-1 s^2, s^2 = 2 cost/(n - p). Parameters the data do not
-// determine (rank-deficient Jacobian) are an InputError naming them. Pure: no files, no printing.
+// correlation matrix from (J^T J)^-1 s^2, s^2 = 2 cost/(n - p). A parameter the data do not
+// determine (a Jacobian column of zeros, a rank-deficient Jacobian, or a 1-sigma range beyond the
+// limits) is held at the base set's value and the fit redone without it, one at a time, until the
+// rest are determined; CurvesFitOptions::strict makes it an InputError naming it instead. Pure: no
+// files, no printing.
 #include <string>
 #include <vector>
 
@@ -43,6 +46,20 @@ struct CurvesFitOptions {
   std::vector<ParameterBounds> bounds;
   std::string where = "data";  ///< names the data source in messages
   int max_iterations = 200;
+  /// false: a parameter the data do not determine is held at the base set's value (see
+  /// CurvesFitResult::held); true: it is an InputError naming it.
+  bool strict = false;
+};
+
+/// A parameter of the requested set that the fit held at the base set's value, and why.
+struct HeldParameter {
+  std::string name;
+  double value = 0.0;  ///< the base set's value it was held at (its own units)
+  /// The rule that held it: "the residuals do not change with it" (a Jacobian column of zeros);
+  /// "the Jacobian is rank-deficient: a combination of ... leaves every residual unchanged;
+  /// condition ..." (held: the largest component of the null vector); "1 sigma: a factor ...,
+  /// beyond a factor 1000" or "1 sigma: +- ..., beyond +- LIMIT" (held: the loosest).
+  std::string reason;
 };
 
 struct CurvesFitResult {
@@ -53,9 +70,12 @@ struct CurvesFitResult {
   std::vector<double> residuals;            ///< per point: ln(model) - ln(data) of the residual's quantity
   std::vector<double> model;                ///< per point: the model's rate [1/s] or stress [Pa] there
   int n = 0, p = 0;
-  double rms = 0.0;   ///< sqrt(mean residual^2)
-  double cost = 0.0;  ///< 0.5 sum residual^2
-  int iterations = 0;
+  double rms = 0.0;    ///< sqrt(mean residual^2)
+  double cost = 0.0;   ///< 0.5 sum residual^2
+  int iterations = 0;  ///< of the last fit (the one without the held parameters)
+  /// Requested parameters held at the base set's values, in the order they were held (empty when
+  /// strict, or when the data determine every one); `parameters` holds the rest.
+  std::vector<HeldParameter> held;
 };
 
 /// Every parameter name the curves fit accepts for this base set: a_0, phi_j, a_inf, phi_c,
@@ -70,8 +90,11 @@ void validate_curves_data(const std::vector<double>& phi, const std::vector<doub
                           const std::vector<double>& shear_stress, const Preset& base, const CurvesFitOptions& options);
 
 /// The fit, starting from the base set's values (they must be feasible: phi_j above every data
-/// phi). InputError for bad data, unknown names, infeasible bounds or undetermined parameters;
-/// NumericalError when Ceres does not converge.
+/// phi). Undetermined parameters are held one at a time (every column of zeros at once; for a
+/// rank-deficient Jacobian the parameter with the largest component of the null singular vector;
+/// for 1-sigma ranges beyond the limits the one furthest beyond), refitting after each.
+/// InputError for bad data, unknown names, infeasible bounds, and undetermined parameters when
+/// options.strict or when every parameter would be held; NumericalError when Ceres does not converge.
 CurvesFitResult fit_curves(const std::vector<double>& phi, const std::vector<double>& shear_rate,
                            const std::vector<double>& shear_stress, const Preset& base,
                            const CurvesFitOptions& options = {});
