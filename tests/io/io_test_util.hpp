@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -87,6 +88,52 @@ inline bool read_h5_attr(const std::string& file, const std::string& object, con
   if (a >= 0) H5Aclose(a);
   H5Fclose(f);
   return ok;
+}
+
+/// A string attribute of the object at `object` ("/" for the file, "/bodies/grains/mass" for a
+/// dataset); false when absent or not a string.
+inline bool read_h5_text_attr(const std::string& file, const std::string& object, const std::string& attr,
+                              std::string& v) {
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (f < 0) return false;
+  bool ok = false;
+  const hid_t a = H5Aopen_by_name(f, object.c_str(), attr.c_str(), H5P_DEFAULT, H5P_DEFAULT);
+  if (a >= 0) {
+    const hid_t t = H5Aget_type(a);
+    if (H5Tget_class(t) == H5T_STRING && H5Tis_variable_str(t) <= 0) {
+      std::string buf(H5Tget_size(t), '\0');
+      ok = H5Aread(a, t, buf.data()) >= 0;
+      v = buf.substr(0, buf.find('\0'));
+    }
+    H5Tclose(t);
+    H5Aclose(a);
+  }
+  H5Fclose(f);
+  return ok;
+}
+
+/// The paths of every dataset in `file` ("/bodies/grains/mass", ...).
+inline std::vector<std::string> h5_datasets(const std::string& file) {
+  std::vector<std::string> out;
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (f < 0) return out;
+  H5Lvisit(
+      f, H5_INDEX_NAME, H5_ITER_NATIVE,
+      [](hid_t group, const char* name, const H5L_info_t*, void* data) -> herr_t {
+        const hid_t o = H5Oopen(group, name, H5P_DEFAULT);
+        if (o >= 0 && H5Iget_type(o) == H5I_DATASET) {
+          std::string path(1, '/');
+          path.append(name);
+          static_cast<std::vector<std::string>*>(data)->push_back(std::move(path));
+        }
+        if (o >= 0) H5Oclose(o);
+        return 0;
+      },
+      &out);
+  H5Fclose(f);
+  return out;
 }
 
 }  // namespace oobleck::test

@@ -3,6 +3,7 @@
 #include <array>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <regex>
 
 #include <gtest/gtest.h>
@@ -72,15 +73,17 @@ TEST(Frames, RoundTrip2DBodiesAndGridExactly) {
   const auto fx = ramp(3, 1.0), fy = ramp(3, 2.0), u = ramp(3, 5.0), w = ramp(3, 6.0), th = ramp(3, 7.0);
 
   PointCloud grains("grains", 2, pos);
-  grains.scalar("pressure", p).vector("velocity", 2, v2).sym_tensor("stress", {s[0], s[1], s[2], s[3], s[4], s[5]});
-  grains.tensor("velocity_gradient", L);
+  grains.scalar("pressure", p, "Pa")
+      .vector("velocity", 2, v2, "m/s")
+      .sym_tensor("stress", {s[0], s[1], s[2], s[3], s[4], s[5]}, "Pa");
+  grains.tensor("velocity_gradient", L, "1/s");
   PointCloud fluid("fluid", {fx, fy});
-  fluid.vector("velocity", {u, w, th});
+  fluid.vector("velocity", {u, w, th}, "m/s");
 
   NodeGrid grid(2, {0.5, -1.0, 0.0}, {0.25, 0.5, 0.0}, {4, 3, 1});
   const auto mass = ramp(12, 0.0, 0.5);
   const auto gv = ramp(24, 1.0, -0.125);
-  grid.scalar("mass", mass).vector("velocity", 2, gv);
+  grid.scalar("mass", mass, "kg/m").vector("velocity", 2, gv, "m/s");
 
   FrameWriter writer(dir.str());
   Frame f0{0.0, 0, {grains, fluid}, grid};
@@ -152,6 +155,37 @@ TEST(Frames, RoundTrip2DBodiesAndGridExactly) {
   EXPECT_EQ(read_h5_doubles(path1, "/bodies/grains/position").values, pos);
 }
 
+TEST(Frames, EveryDatasetCarriesItsUnits) {
+  TempDir dir;
+  const auto pos = ramp(6, 0.0), p = ramp(3, 1.0), v = ramp(6, 2.0), t6 = ramp(18, 3.0);
+  PointCloud grains("grains", 2, pos);
+  grains.scalar("mass", p, "kg/rad").vector("velocity", 2, v, "m/s").sym_tensor("stress", t6, "Pa");
+  PointCloud rod("rod", 2, pos, "mm");  // positions in other units than metres
+  rod.scalar("f", p, "1");
+  NodeGrid grid(2, {0, 0, 0}, {1, 1, 0}, {3, 2, 1});
+  grid.scalar("porosity", ramp(6, 0.5), "1");
+  FrameWriter writer(dir.str());
+  const std::string path = writer.write({0.0, 0, {grains, rod}, grid});
+  const std::map<std::string, std::string> expected = {{"/bodies/grains/position", "m"},
+                                                       {"/bodies/grains/connectivity", "1"},
+                                                       {"/bodies/grains/mass", "kg/rad"},
+                                                       {"/bodies/grains/velocity", "m/s"},
+                                                       {"/bodies/grains/stress", "Pa"},
+                                                       {"/bodies/rod/position", "mm"},
+                                                       {"/bodies/rod/connectivity", "1"},
+                                                       {"/bodies/rod/f", "1"},
+                                                       {"/grid/porosity", "1"}};
+  const std::vector<std::string> datasets = oobleck::test::h5_datasets(path);
+  EXPECT_EQ(datasets.size(), expected.size());
+  for (const std::string& d : datasets) {
+    std::string units;
+    EXPECT_TRUE(oobleck::test::read_h5_text_attr(path, d, "units", units)) << d << " has no units";
+    ASSERT_TRUE(expected.count(d) == 1) << d;
+    EXPECT_EQ(units, expected.at(d)) << d;
+  }
+  EXPECT_EQ(run_checker(dir.file("frames.xmf")), 0);  // (the index is unchanged by the attributes)
+}
+
 TEST(Frames, Grid3DNodeOrderingIsXFastest) {
   TempDir dir;
   const std::size_t nx = 3, ny = 2, nz = 2, nn = nx * ny * nz;
@@ -166,7 +200,7 @@ TEST(Frames, Grid3DNodeOrderingIsXFastest) {
         vz[a] = static_cast<double>(k);
       }
   NodeGrid grid(3, {0, 0, 0}, {0.1, 0.2, 0.3}, {nx, ny, nz});
-  grid.scalar("id", id).vector("velocity", {vx, vy, vz});
+  grid.scalar("id", id, "1").vector("velocity", {vx, vy, vz}, "m/s");
   const auto pos = ramp(3 * 4, 0.0, 0.1);
   PointCloud solid("solid", 3, pos);
   FrameWriter writer(dir.str(), "run");
@@ -210,7 +244,7 @@ TEST(Frames, GridPartLandsInItsBox) {
   NodeGrid grid(3, {0, 0, 0}, {0.1, 0.1, 0.1}, {nx, ny, nz});
   grid.set_part(begin, extent);
   EXPECT_EQ(grid.count(), n);
-  grid.scalar("id", id).vector("velocity", {vx, vy, vz});
+  grid.scalar("id", id, "1").vector("velocity", {vx, vy, vz}, "m/s");
   FrameWriter writer(dir.str(), "run");
   const std::string path = writer.write({0.0, 0, {}, grid});
   const auto r = read_h5_doubles(path, "/grid/id");
@@ -233,7 +267,7 @@ TEST(Frames, GridPartLandsInItsBox) {
   EXPECT_EQ(inside, static_cast<int>(n));
   NodeGrid other(3, {0, 0, 0}, {0.1, 0.1, 0.1}, {nx, ny, nz});
   EXPECT_THROW(other.set_part({3, 0, 0}, {2, 1, 1}), std::invalid_argument);  // leaves the grid along x
-  other.scalar("id", std::vector<double>(nx * ny * nz, 1.0));
+  other.scalar("id", std::vector<double>(nx * ny * nz, 1.0), "1");
   EXPECT_THROW(other.set_part(begin, extent), std::invalid_argument);  // after a field
 }
 
@@ -245,9 +279,9 @@ TEST(Frames, IndexReferencesExistingDatasetsWithMatchingDimensions) {
   FrameWriter writer(dir.str());
   for (int k = 0; k < 3; ++k) {
     PointCloud b("grains", 2, pos);
-    b.scalar("phi", sc).sym_tensor("stress", t6);
+    b.scalar("phi", sc, "1").sym_tensor("stress", t6, "Pa");
     NodeGrid g(2, {0, 0, 0}, {1, 1, 1}, {2, 2, 1});
-    g.scalar("mass", sc);
+    g.scalar("mass", sc, "kg");
     writer.write({0.1 * k, 10 * k, {b}, g});
   }
   const std::string xmf_path = writer.index_path();
@@ -290,10 +324,10 @@ TEST(Frames, IndexPassesCheckerAfterEveryFrame) {
   FrameWriter writer(dir.str());
   for (int k = 0; k < 3; ++k) {
     PointCloud b("grains", 3, pos);
-    b.vector("velocity", 3, v);
+    b.vector("velocity", 3, v, "m/s");
     NodeGrid g(3, {0, 0, 0}, {1, 1, 1}, {2, 2, 2});
     const auto m = ramp(8, 0.0);
-    g.scalar("mass", m);
+    g.scalar("mass", m, "kg");
     writer.write({0.5 * k, k, {b}, g});
     EXPECT_EQ(run_checker(writer.index_path()), 0) << "after frame " << k;
     EXPECT_EQ(run_checker(writer.index_path(), true), 0) << "after frame " << k;
@@ -363,7 +397,7 @@ TEST(Frames, EmptyBodyStaysOutOfTheIndex) {
   const auto pos = ramp(4, 0.0);
   FrameWriter w(dir.str());
   PointCloud empty("solid", 2, none);
-  empty.scalar("mass", none);
+  empty.scalar("mass", none, "kg");
   const std::string p = w.write({0.0, 0, {PointCloud("grains", 2, pos), empty}, std::nullopt});
   const std::string xmf = read_text(w.index_path());
   EXPECT_EQ(xmf.find("Name=\"solid\""), std::string::npos);
@@ -386,14 +420,18 @@ TEST(Frames, BadInputIsRefused) {
   const auto three = ramp(3, 0.0);
   const auto two = ramp(2, 0.0);
   PointCloud b("grains", 2, pos);  // 3 points
-  EXPECT_THROW(b.scalar("p", two), std::invalid_argument);
-  EXPECT_THROW(b.vector("v", 4, pos), std::invalid_argument);
-  EXPECT_THROW(b.vector("v", {three}), std::invalid_argument);
-  EXPECT_THROW(b.scalar("bad name", three), std::invalid_argument);
-  EXPECT_THROW(b.scalar("a<b", three), std::invalid_argument);
-  EXPECT_THROW(b.scalar("position", three), std::invalid_argument);
-  b.scalar("p", three);
-  EXPECT_THROW(b.scalar("p", three), std::invalid_argument);
+  EXPECT_THROW(b.scalar("p", two, "Pa"), std::invalid_argument);
+  EXPECT_THROW(b.vector("v", 4, pos, "m/s"), std::invalid_argument);
+  EXPECT_THROW(b.vector("v", {three}, "m/s"), std::invalid_argument);
+  EXPECT_THROW(b.scalar("bad name", three, "1"), std::invalid_argument);
+  EXPECT_THROW(b.scalar("a<b", three, "1"), std::invalid_argument);
+  EXPECT_THROW(b.scalar("position", three, "m"), std::invalid_argument);
+  EXPECT_THROW(b.scalar("q", three, ""), std::invalid_argument);     // units required
+  EXPECT_THROW(b.scalar("q", three, "m\n"), std::invalid_argument);  // printable only
+  EXPECT_THROW(b.scalar("q", three, std::string(65, 'm')), std::invalid_argument);
+  EXPECT_THROW(PointCloud("grains", 2, pos, ""), std::invalid_argument);
+  b.scalar("p", three, "Pa");
+  EXPECT_THROW(b.scalar("p", three, "Pa"), std::invalid_argument);
   EXPECT_THROW(PointCloud("grains", 2, three), std::invalid_argument);  // 3 values, dim 2
   EXPECT_THROW(PointCloud("grains", {three, two}), std::invalid_argument);
   EXPECT_THROW(NodeGrid(2, {0, 0, 0}, {1, 1, 1}, {2, 2, 2}), std::invalid_argument);
@@ -412,9 +450,9 @@ TEST(Frames, ParaViewOpensTheIndex) {
   FrameWriter w(dir.str());
   for (int k = 0; k < 2; ++k) {
     PointCloud b("grains", 2, pos);
-    b.scalar("pressure", p).vector("velocity", 2, v);
+    b.scalar("pressure", p, "Pa").vector("velocity", 2, v, "m/s");
     NodeGrid g(2, {0, 0, 0}, {0.5, 0.5, 0}, {3, 2, 1});
-    g.scalar("mass", m);
+    g.scalar("mass", m, "kg");
     w.write({0.1 * k, k, {b}, g});
   }
   const std::string out = dir.file("probe.txt");
@@ -440,7 +478,7 @@ TEST(Frames, LongIndexStaysValidAndIsCompletedByFlush) {
     FrameWriter w(dir.str());
     for (int k = 0; k < frames; ++k) {
       PointCloud b("grains", 2, pos);
-      for (int f = 0; f < 40; ++f) b.scalar("field_" + std::to_string(f), val);
+      for (int f = 0; f < 40; ++f) b.scalar("field_" + std::to_string(f), val, "1");
       w.write({1e-3 * k, k, {b}, std::nullopt});
       if (k % 25 == 24) {
         const std::string xmf = read_text(w.index_path());

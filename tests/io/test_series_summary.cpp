@@ -1,6 +1,7 @@
 // CSV time series (header, rows flushed as written, resume after restart) and summary.json.
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 
 #include <gtest/gtest.h>
@@ -74,6 +75,35 @@ TEST(Series, ResumeDropsRowsAfterTheRestartPoint) {
   std::ofstream(path, std::ios::app) << "30\n";
   EXPECT_THROW(SeriesWriter::resume(path, {"step", "e"}, 100), InputError);
   EXPECT_THROW(SeriesWriter::resume(dir.file("none.csv"), {"step"}, 20), InputError);
+}
+
+TEST(Series, UnitsLineComesFirstAndNamesEveryColumn) {
+  TempDir dir;
+  const std::string path = dir.file("series.csv");
+  {
+    SeriesWriter s(path, {"time", "step", "mass_grains"}, {"s", "1", "kg/rad"});
+    s.row({0.0, 0, 1.5});
+    s.row({1e-3, 10, 1.5});
+  }
+  EXPECT_EQ(read_text(path),
+            "# units: time=s, step=1, mass_grains=kg/rad\ntime,step,mass_grains\n0,0,1.5\n0.001,10,1.5\n");
+  {  // a restart keeps the rows up to its time and writes the units line once
+    SeriesWriter s = SeriesWriter::resume(path, {"time", "step", "mass_grains"}, 0.0, {"s", "1", "kg/rad"});
+    EXPECT_EQ(s.rows_written(), 1u);
+  }
+  EXPECT_EQ(read_text(path), "# units: time=s, step=1, mass_grains=kg/rad\ntime,step,mass_grains\n0,0,1.5\n");
+  // A series written without units (an older run) resumes with them.
+  std::ofstream(path, std::ios::trunc) << "time,step,mass_grains\n0,0,1.5\n0.001,10,1.5\n";
+  {
+    SeriesWriter s = SeriesWriter::resume(path, {"time", "step", "mass_grains"}, 1.0, {"s", "1", "kg/rad"});
+    EXPECT_EQ(s.rows_written(), 2u);
+  }
+  EXPECT_EQ(read_text(path),
+            "# units: time=s, step=1, mass_grains=kg/rad\ntime,step,mass_grains\n0,0,1.5\n0.001,10,1.5\n");
+  EXPECT_THROW(SeriesWriter(dir.file("t.csv"), {"a", "b"}, {"s"}), std::invalid_argument);  // one per column
+  EXPECT_THROW(SeriesWriter(dir.file("t.csv"), {"a"}, {""}), std::invalid_argument);
+  EXPECT_THROW(SeriesWriter(dir.file("t.csv"), {"a"}, {"m,s"}), std::invalid_argument);
+  EXPECT_THROW(SeriesWriter(dir.file("t.csv"), {"a"}, {"a=b"}), std::invalid_argument);
 }
 
 TEST(Summary, WritesJsonAtomically) {

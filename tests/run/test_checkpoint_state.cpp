@@ -56,7 +56,7 @@ std::string save(const clitest::TempDir& d, Owner& o, const std::string& name = 
   cp.set_step(7);
   cp.set_time(0.25);
   cp.set_config("");
-  run::save_fields(cp, o.fields());
+  run::save_fields(cp, o.fields(), [](const char* unit) { return std::string(unit); });
   cp.commit();
   return path;
 }

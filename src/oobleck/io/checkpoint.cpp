@@ -175,9 +175,9 @@ std::vector<std::uint64_t> new_array(CheckpointWriter::Impl& impl, const std::st
 
 template <class T>
 void write_array(CheckpointWriter::Impl& impl, const std::string& path, const std::string& name, hid_t type,
-                 std::span<const T> data, std::vector<std::uint64_t> shape) {
+                 std::span<const T> data, std::vector<std::uint64_t> shape, const std::string& units) {
   shape = new_array(impl, path, name, data.size(), std::move(shape));
-  auto write = [&impl, path, name, type, shape](hid_t, hid_t arrays, std::span<const T> values) {
+  auto write = [&impl, path, name, type, shape, units](hid_t, hid_t arrays, std::span<const T> values) {
     try {
       h5::write_dataset_part(arrays, name, type, shape, std::vector<std::uint64_t>(shape.size(), 0), shape,
                              values.data(), impl.lcpl.get());
@@ -186,6 +186,7 @@ void write_array(CheckpointWriter::Impl& impl, const std::string& path, const st
     }
     h5::Handle dset(H5Dopen2(arrays, name.c_str(), H5P_DEFAULT));
     h5::write_attribute(dset.get(), "checksum", as_int64(fnv1a(values.data(), values.size_bytes())));
+    if (!units.empty()) h5::write_attribute(dset.get(), "units", units);
   };
   if (!impl.every_rank) {
     write(impl.file.get(), impl.arrays.get(), data);
@@ -198,8 +199,8 @@ void write_array(CheckpointWriter::Impl& impl, const std::string& path, const st
 
 template <class T>
 void write_ranks_array(CheckpointWriter::Impl& impl, const std::string& path, const std::string& name, hid_t type,
-                       std::span<const T> data) {
-  if (!impl.every_rank) return write_array(impl, path, name, type, data, {});
+                       std::span<const T> data, const std::string& units) {
+  if (!impl.every_rank) return write_array(impl, path, name, type, data, {}, units);
   new_array(impl, path, name, data.size(), {data.size()});  // (this rank's block)
   // Every rank's block: its values and checksum; this rank's block starts after the lower ranks'.
   const std::int64_t mine[2] = {static_cast<std::int64_t>(data.size()),
@@ -223,25 +224,28 @@ void write_ranks_array(CheckpointWriter::Impl& impl, const std::string& path, co
   h5::Handle dset(H5Dopen2(impl.arrays.get(), name.c_str(), H5P_DEFAULT));
   h5::write_attribute(dset.get(), "block_values", values);
   h5::write_attribute(dset.get(), "block_checksums", checksums);
+  if (!units.empty()) h5::write_attribute(dset.get(), "units", units);
 }
 }  // namespace
 
-void CheckpointWriter::array(const std::string& name, std::span<const double> data, std::vector<std::uint64_t> shape) {
-  write_array(*impl_, path_, name, H5T_NATIVE_DOUBLE, data, std::move(shape));
+void CheckpointWriter::array(const std::string& name, std::span<const double> data, std::vector<std::uint64_t> shape,
+                             const std::string& units) {
+  write_array(*impl_, path_, name, H5T_NATIVE_DOUBLE, data, std::move(shape), units);
 }
 void CheckpointWriter::array(const std::string& name, std::span<const std::int64_t> data,
-                             std::vector<std::uint64_t> shape) {
-  write_array(*impl_, path_, name, H5T_NATIVE_INT64, data, std::move(shape));
+                             std::vector<std::uint64_t> shape, const std::string& units) {
+  write_array(*impl_, path_, name, H5T_NATIVE_INT64, data, std::move(shape), units);
 }
 void CheckpointWriter::array(const std::string& name, std::span<const std::uint8_t> data,
-                             std::vector<std::uint64_t> shape) {
-  write_array(*impl_, path_, name, H5T_NATIVE_UINT8, data, std::move(shape));
+                             std::vector<std::uint64_t> shape, const std::string& units) {
+  write_array(*impl_, path_, name, H5T_NATIVE_UINT8, data, std::move(shape), units);
 }
-void CheckpointWriter::ranks_array(const std::string& name, std::span<const double> data) {
-  write_ranks_array(*impl_, path_, name, H5T_NATIVE_DOUBLE, data);
+void CheckpointWriter::ranks_array(const std::string& name, std::span<const double> data, const std::string& units) {
+  write_ranks_array(*impl_, path_, name, H5T_NATIVE_DOUBLE, data, units);
 }
-void CheckpointWriter::ranks_array(const std::string& name, std::span<const std::uint8_t> data) {
-  write_ranks_array(*impl_, path_, name, H5T_NATIVE_UINT8, data);
+void CheckpointWriter::ranks_array(const std::string& name, std::span<const std::uint8_t> data,
+                                   const std::string& units) {
+  write_ranks_array(*impl_, path_, name, H5T_NATIVE_UINT8, data, units);
 }
 
 void CheckpointWriter::commit() {

@@ -9,7 +9,8 @@
 //                raw bytes, as int64) detects damaged data that HDF5 itself would not notice. An
 //                array that the ranks of a decomposed run wrote together has instead
 //                `block_checksums` (FNV-1a 64 of each rank's block, in rank order) and
-//                `block_values` (the values in each block)
+//                `block_values` (the values in each block); attribute `units` when the writer
+//                gave them (a run gives every array's: "m", "kg/rad", "1")
 //
 // Names may contain '/' to group arrays ("grains/velocity"). Values are written in the native
 // representation and read back without conversion: the round trip is bit-exact (NaN payloads
@@ -52,14 +53,18 @@ class CheckpointWriter {
 
   /// Store `data` under `name` with `shape` (empty: one dimension of data.size()). The product
   /// of the shape must equal data.size() (std::invalid_argument otherwise); names are unique.
-  void array(const std::string& name, std::span<const double> data, std::vector<std::uint64_t> shape = {});
-  void array(const std::string& name, std::span<const std::int64_t> data, std::vector<std::uint64_t> shape = {});
-  void array(const std::string& name, std::span<const std::uint8_t> data, std::vector<std::uint64_t> shape = {});
+  /// `units` not empty: the dataset's string attribute `units`.
+  void array(const std::string& name, std::span<const double> data, std::vector<std::uint64_t> shape = {},
+             const std::string& units = {});
+  void array(const std::string& name, std::span<const std::int64_t> data, std::vector<std::uint64_t> shape = {},
+             const std::string& units = {});
+  void array(const std::string& name, std::span<const std::uint8_t> data, std::vector<std::uint64_t> shape = {},
+             const std::string& units = {});
 
   /// Store under `name` every rank's `data` concatenated in rank order (one dimension): the
   /// points of a decomposed run, written by every rank at once. One writer: array(name, data).
-  void ranks_array(const std::string& name, std::span<const double> data);
-  void ranks_array(const std::string& name, std::span<const std::uint8_t> data);
+  void ranks_array(const std::string& name, std::span<const double> data, const std::string& units = {});
+  void ranks_array(const std::string& name, std::span<const std::uint8_t> data, const std::string& units = {});
 
   /// Close and atomically rename to the target path. Throws std::runtime_error when the file
   /// cannot be completed (disk full); the previous checkpoint at `path`, if any, is then kept.

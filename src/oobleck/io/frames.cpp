@@ -50,6 +50,20 @@ void check_name(const std::string& name, const char* what) {
   if (!is_plain_name(name)) throw std::invalid_argument(fmt::format("{} name '{}': {}", what, name, kPlainNameRule));
 }
 
+/// Units: 1-64 printable ASCII characters ("m/s", "N s/rad", "1").
+void check_units(const std::string& units, const std::string& owner) {
+  const bool ok = !units.empty() && units.size() <= 64 &&
+                  std::all_of(units.begin(), units.end(), [](char c) { return c >= ' ' && c <= '~'; });
+  if (!ok)
+    throw std::invalid_argument(fmt::format("{}: units '{}': use 1-64 printable ASCII characters", owner, units));
+}
+
+/// The dataset `name` under `loc` gets the string attribute `units`.
+void write_units(hid_t loc, const std::string& name, const std::string& units) {
+  h5::Handle d(H5Dopen2(loc, name.c_str(), H5P_DEFAULT));
+  h5::write_attribute(d.get(), "units", units);
+}
+
 std::vector<std::span<const double>> spans(std::initializer_list<std::span<const double>> list) {
   return std::vector<std::span<const double>>(list.begin(), list.end());
 }
@@ -119,6 +133,7 @@ void write_field(hid_t loc, const std::string& h5_prefix, const FieldView& f, st
   {
     h5::Handle d(H5Dopen2(loc, f.name.c_str(), H5P_DEFAULT));
     h5::write_attribute(d.get(), "type", std::string(xdmf_type_name(f.type)));
+    h5::write_attribute(d.get(), "units", f.units);
   }
   xml += fmt::format("{}<Attribute Name=\"{}\" AttributeType=\"{}\" Center=\"Node\">\n", indent, f.name,
                      xdmf_type_name(f.type));
@@ -145,6 +160,7 @@ constexpr const char* kGridBlock = "grid";
 
 void FieldSet::add(FieldView field) {
   check_name(field.name, "field");
+  check_units(field.units, fmt::format("field '{}'", field.name));
   if (field.name == "position") throw std::invalid_argument("field name 'position' is reserved for point positions");
   for (const auto& f : fields_) {
     if (f.name == field.name) throw std::invalid_argument(fmt::format("field '{}' given twice", field.name));
@@ -170,54 +186,61 @@ void FieldSet::add(FieldView field) {
   fields_.push_back(std::move(field));
 }
 
-FieldSet& FieldSet::scalar(std::string name, std::span<const double> values) {
-  add({std::move(name), FieldType::scalar, 1, {values}});
+FieldSet& FieldSet::scalar(std::string name, std::span<const double> values, std::string units) {
+  add({std::move(name), FieldType::scalar, 1, {values}, std::move(units)});
   return *this;
 }
 
-FieldSet& FieldSet::vector(std::string name, int components, std::span<const double> interleaved) {
+FieldSet& FieldSet::vector(std::string name, int components, std::span<const double> interleaved, std::string units) {
   if (components != 2 && components != 3) {
     throw std::invalid_argument(fmt::format("vector field '{}': {} components, expected 2 or 3", name, components));
   }
-  add({std::move(name), FieldType::vector, components, {interleaved}});
+  add({std::move(name), FieldType::vector, components, {interleaved}, std::move(units)});
   return *this;
 }
 
-FieldSet& FieldSet::vector(std::string name, std::initializer_list<std::span<const double>> components) {
+FieldSet& FieldSet::vector(std::string name, std::initializer_list<std::span<const double>> components,
+                           std::string units) {
   const auto n = static_cast<int>(components.size());
   if (n != 2 && n != 3) {
     throw std::invalid_argument(fmt::format("vector field '{}': {} component spans, expected 2 or 3", name, n));
   }
-  add({std::move(name), FieldType::vector, n, spans(components)});
+  add({std::move(name), FieldType::vector, n, spans(components), std::move(units)});
   return *this;
 }
 
-FieldSet& FieldSet::sym_tensor(std::string name, std::span<const double> interleaved) {
-  add({std::move(name), FieldType::sym_tensor, 6, {interleaved}});
+FieldSet& FieldSet::sym_tensor(std::string name, std::span<const double> interleaved, std::string units) {
+  add({std::move(name), FieldType::sym_tensor, 6, {interleaved}, std::move(units)});
   return *this;
 }
 
-FieldSet& FieldSet::sym_tensor(std::string name, std::initializer_list<std::span<const double>> components) {
-  add({std::move(name), FieldType::sym_tensor, 6, spans(components)});
+FieldSet& FieldSet::sym_tensor(std::string name, std::initializer_list<std::span<const double>> components,
+                               std::string units) {
+  add({std::move(name), FieldType::sym_tensor, 6, spans(components), std::move(units)});
   return *this;
 }
 
-FieldSet& FieldSet::tensor(std::string name, std::span<const double> interleaved) {
-  add({std::move(name), FieldType::tensor, 9, {interleaved}});
+FieldSet& FieldSet::tensor(std::string name, std::span<const double> interleaved, std::string units) {
+  add({std::move(name), FieldType::tensor, 9, {interleaved}, std::move(units)});
   return *this;
 }
 
-FieldSet& FieldSet::tensor(std::string name, std::initializer_list<std::span<const double>> components) {
-  add({std::move(name), FieldType::tensor, 9, spans(components)});
+FieldSet& FieldSet::tensor(std::string name, std::initializer_list<std::span<const double>> components,
+                           std::string units) {
+  add({std::move(name), FieldType::tensor, 9, spans(components), std::move(units)});
   return *this;
 }
 
 // ---------------------------------------------------------------------------------------------
 // PointCloud, NodeGrid
 
-PointCloud::PointCloud(std::string name, int dim, std::span<const double> positions)
-    : FieldSet(dim > 0 ? positions.size() / static_cast<std::size_t>(dim) : 0), name_(std::move(name)), dim_(dim) {
+PointCloud::PointCloud(std::string name, int dim, std::span<const double> positions, std::string position_units)
+    : FieldSet(dim > 0 ? positions.size() / static_cast<std::size_t>(dim) : 0),
+      name_(std::move(name)),
+      dim_(dim),
+      position_units_(std::move(position_units)) {
   check_name(name_, "body");
+  check_units(position_units_, fmt::format("body '{}': positions", name_));
   if (dim != 2 && dim != 3) throw std::invalid_argument(fmt::format("body '{}': dim {} is not 2 or 3", name_, dim));
   if (positions.size() % static_cast<std::size_t>(dim) != 0) {
     throw std::invalid_argument(
@@ -226,12 +249,15 @@ PointCloud::PointCloud(std::string name, int dim, std::span<const double> positi
   positions_ = {positions};
 }
 
-PointCloud::PointCloud(std::string name, std::initializer_list<std::span<const double>> positions)
+PointCloud::PointCloud(std::string name, std::initializer_list<std::span<const double>> positions,
+                       std::string position_units)
     : FieldSet(positions.size() > 0 ? positions.begin()->size() : 0),
       name_(std::move(name)),
       dim_(static_cast<int>(positions.size())),
-      positions_(spans(positions)) {
+      positions_(spans(positions)),
+      position_units_(std::move(position_units)) {
   check_name(name_, "body");
+  check_units(position_units_, fmt::format("body '{}': positions", name_));
   if (dim_ != 2 && dim_ != 3) {
     throw std::invalid_argument(fmt::format("body '{}': {} position spans, expected 2 or 3", name_, dim_));
   }
@@ -369,6 +395,7 @@ std::string write_body_block(hid_t bodies, const PointCloud& b, std::size_t firs
     const auto buf = interleave(b.positions(), mine, b.dim(), b.dim());
     h5::write_dataset_part(g.get(), "position", H5T_NATIVE_DOUBLE, xyz.shape, xyz.start, xyz.count, buf.data());
   }
+  write_units(g.get(), "position", b.position_units());
   const std::vector<std::uint64_t>& pshape = xyz.shape;
   // Explicit vertex list 0..N-1: the Xdmf3 readers make no cells of a Polyvertex topology
   // without one (points then do not render); the XDMF (2) reader accepts it too.
@@ -382,6 +409,7 @@ std::string write_body_block(hid_t bodies, const PointCloud& b, std::size_t firs
     for (std::size_t i = 0; i < mine; ++i) conn[i] = static_cast<std::int64_t>(first + i);
     h5::write_dataset_part(g.get(), "connectivity", H5T_NATIVE_INT64, {n}, {first}, {mine}, conn.data());
   }
+  write_units(g.get(), "connectivity", "1");  // (point indices)
   h5::write_attribute(g.get(), "count", static_cast<std::int64_t>(n));
   std::string xml;
   const std::string prefix = fmt::format("{}:/bodies/{}", rel, b.name());

@@ -24,7 +24,10 @@
 //   /grid/FIELD                    (nz, ny, nx[, c]) node values, x fastest; nz = 1 in 2D
 //   /grid                          attributes: origin, spacing (x, y, z order), nodes (nx, ny, nz)
 //   /bodies/NAME, /grid            attribute xdmf: the block's <Grid> element (used on resume)
-// Every field dataset carries an attribute `type` = Scalar | Vector | Tensor6 | Tensor.
+// Every field dataset carries an attribute `type` = Scalar | Vector | Tensor6 | Tensor, and every
+// dataset (position and connectivity included) a string attribute `units`: the field's unit as
+// given ("m", "m/s", "Pa", "kg/rad", "1" for dimensionless; position: the cloud's position units,
+// connectivity: "1").
 //
 // The writer depends on nothing but spans of doubles, so it serves any solver layout:
 // interleaved arrays (x0 y0 x1 y1 ...) or structure of arrays (one span per component).
@@ -71,10 +74,12 @@ struct FieldView {
   FieldType type = FieldType::scalar;
   int components = 1;  ///< input components per item (vectors: 2 or 3)
   std::vector<std::span<const double>> parts;
+  std::string units;  ///< the `units` attribute of its dataset ("m/s", "Pa", "1" dimensionless)
 };
 
-/// Named fields over `count` items (points of a body, nodes of a grid). Names are 1–64
-/// characters of [A-Za-z0-9_.-] and unique; sizes are checked against count. Violations are
+/// Named fields over `count` items (points of a body, nodes of a grid), each with its units.
+/// Names are 1–64 characters of [A-Za-z0-9_.-] and unique; units are 1–64 printable ASCII
+/// characters ("1" for dimensionless); sizes are checked against count. Violations are
 /// programming errors: std::invalid_argument naming the field.
 class FieldSet {
  public:
@@ -82,19 +87,19 @@ class FieldSet {
   std::size_t count() const { return count_; }
   const std::vector<FieldView>& fields() const { return fields_; }
 
-  FieldSet& scalar(std::string name, std::span<const double> values);
+  FieldSet& scalar(std::string name, std::span<const double> values, std::string units);
   /// 2 or 3 components per item, interleaved.
-  FieldSet& vector(std::string name, int components, std::span<const double> interleaved);
+  FieldSet& vector(std::string name, int components, std::span<const double> interleaved, std::string units);
   /// 2 or 3 spans, one per component.
-  FieldSet& vector(std::string name, std::initializer_list<std::span<const double>> components);
+  FieldSet& vector(std::string name, std::initializer_list<std::span<const double>> components, std::string units);
   /// 6 values per item, interleaved, order xx xy xz yy yz zz.
-  FieldSet& sym_tensor(std::string name, std::span<const double> interleaved);
+  FieldSet& sym_tensor(std::string name, std::span<const double> interleaved, std::string units);
   /// 6 spans in the order xx xy xz yy yz zz.
-  FieldSet& sym_tensor(std::string name, std::initializer_list<std::span<const double>> components);
+  FieldSet& sym_tensor(std::string name, std::initializer_list<std::span<const double>> components, std::string units);
   /// 9 values per item, interleaved, row-major.
-  FieldSet& tensor(std::string name, std::span<const double> interleaved);
+  FieldSet& tensor(std::string name, std::span<const double> interleaved, std::string units);
   /// 9 spans, row-major.
-  FieldSet& tensor(std::string name, std::initializer_list<std::span<const double>> components);
+  FieldSet& tensor(std::string name, std::initializer_list<std::span<const double>> components, std::string units);
 
  protected:
   void add(FieldView field);
@@ -102,21 +107,25 @@ class FieldSet {
   std::vector<FieldView> fields_;
 };
 
-/// The points of one body: positions plus any fields (shown as a Polyvertex grid in ParaView).
+/// The points of one body: positions (in `position_units`, metres unless given) plus any fields
+/// (shown as a Polyvertex grid in ParaView).
 class PointCloud : public FieldSet {
  public:
   /// `dim` = 2 or 3; `positions` interleaved, its size a multiple of dim.
-  PointCloud(std::string name, int dim, std::span<const double> positions);
+  PointCloud(std::string name, int dim, std::span<const double> positions, std::string position_units = "m");
   /// Positions as 2 or 3 spans (x, y[, z]) of equal length.
-  PointCloud(std::string name, std::initializer_list<std::span<const double>> positions);
+  PointCloud(std::string name, std::initializer_list<std::span<const double>> positions,
+             std::string position_units = "m");
   const std::string& name() const { return name_; }
   int dim() const { return dim_; }
   const std::vector<std::span<const double>>& positions() const { return positions_; }
+  const std::string& position_units() const { return position_units_; }
 
  private:
   std::string name_;
   int dim_;
   std::vector<std::span<const double>> positions_;
+  std::string position_units_;
 };
 
 /// A uniform Cartesian grid of nodes: node (i, j, k) sits at origin + (i dx, j dy, k dz); node

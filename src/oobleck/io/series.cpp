@@ -32,14 +32,33 @@ std::string header_line(const std::vector<std::string>& columns) {
   return line;
 }
 
+/// "# units: a=s, b=1\n" for `units` beside `columns` (nothing when `units` is empty).
+std::string units_line(const std::vector<std::string>& columns, const std::vector<std::string>& units) {
+  if (units.empty()) return {};
+  if (units.size() != columns.size()) {
+    throw std::invalid_argument(fmt::format("series: {} units for {} columns", units.size(), columns.size()));
+  }
+  std::string line = "# units: ";
+  for (std::size_t i = 0; i < units.size(); ++i) {
+    const auto& u = units[i];
+    if (u.empty() || u.find_first_of(",=\n\r") != std::string::npos) {
+      throw std::invalid_argument(
+          fmt::format("series column '{}': units '{}' empty or contain , = or a line break", columns[i], u));
+    }
+    if (i > 0) line += ", ";
+    line += columns[i] + "=" + u;
+  }
+  return line + "\n";
+}
+
 }  // namespace
 
 SeriesWriter::SeriesWriter(std::string path, std::vector<std::string> columns, std::FILE* f)
     : path_(std::move(path)), columns_(std::move(columns)), file_(f) {}
 
-SeriesWriter::SeriesWriter(std::string path, std::vector<std::string> columns)
+SeriesWriter::SeriesWriter(std::string path, std::vector<std::string> columns, std::vector<std::string> units)
     : path_(std::move(path)), columns_(std::move(columns)) {
-  const std::string header = header_line(columns_);
+  const std::string header = units_line(columns_, units) + header_line(columns_);
   check_writable(path_, "series");
   file_ = std::fopen(path_.c_str(), "w");
   if (file_ == nullptr) throw InputError(fmt::format("series '{}': cannot open for writing", path_));
@@ -48,8 +67,10 @@ SeriesWriter::SeriesWriter(std::string path, std::vector<std::string> columns)
   }
 }
 
-SeriesWriter SeriesWriter::resume(std::string path, std::vector<std::string> columns, double keep_until) {
+SeriesWriter SeriesWriter::resume(std::string path, std::vector<std::string> columns, double keep_until,
+                                  std::vector<std::string> units) {
   const std::string header = header_line(columns);
+  const std::string units_text = units_line(columns, units);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(fmt::format("series '{}': cannot resume, the file does not exist", path));
   std::stringstream ss;
@@ -61,13 +82,18 @@ SeriesWriter SeriesWriter::resume(std::string path, std::vector<std::string> col
     text.erase(text.rfind('\n') == std::string::npos ? 0 : text.rfind('\n') + 1);
   std::istringstream lines(text);
   std::string line;
-  if (!std::getline(lines, line) || line != header) {
+  bool read = false;
+  std::size_t lineno = 0;
+  while ((read = static_cast<bool>(std::getline(lines, line))) && line.starts_with('#')) ++lineno;
+  ++lineno;
+  if (!read || line != header) {
     throw InputError(fmt::format("series '{}': cannot resume, its header '{}' differs from '{}'", path, line, header));
   }
-  std::string kept = header + "\n";
+  std::string kept = units_text + header + "\n";
   std::size_t rows = 0;
   while (std::getline(lines, line)) {
-    if (line.empty()) continue;
+    ++lineno;
+    if (line.empty() || line.starts_with('#')) continue;
     const auto fields = static_cast<std::size_t>(std::count(line.begin(), line.end(), ',')) + 1;
     const std::string first = line.substr(0, line.find(','));
     double key = 0;
@@ -80,7 +106,7 @@ SeriesWriter SeriesWriter::resume(std::string path, std::vector<std::string> col
       ok = false;
     }
     if (!ok) {
-      throw InputError(fmt::format("series '{}': cannot resume, row {} ('{}') is not {} numbers", path, rows + 2, line,
+      throw InputError(fmt::format("series '{}': cannot resume, line {} ('{}') is not {} numbers", path, lineno, line,
                                    columns.size()));
     }
     if (key > keep_until) break;

@@ -55,7 +55,7 @@ class WheelAnalysis final : public SceneAnalysis<G> {
   /// points, cells) and the track.
   void declare_state(mpm::FieldList& list) override {
     list.add_series(
-        "pressure_scatter", "SI",
+        "pressure_scatter", "rows of t [s], relative [1], rms deviation [Pa], rms [Pa], points [1], cells [1]",
         [this] {
           std::vector<double> flat;
           for (const auto& r : scatter_)

@@ -60,7 +60,9 @@ class BodyTrack {
   void declare_fields(mpm::FieldList& list) {
     constexpr std::size_t w = 4 + D + 2 * NC;
     list.add_series(
-        "track", "SI",
+        "track",
+        "rows of t [s], bottom [m], omega [rad/s], torque [N m], centre [m], velocity [m/s], force [N] (2D: torque "
+        "and force per m or rad)",
         [this] {
           std::vector<double> flat;
           flat.reserve(track_.size() * w);

@@ -33,23 +33,25 @@ mpm::FieldList solver_fields(const scene::BuiltScene<G>& scene) {
   return list;
 }
 
-void save_fields(io::CheckpointWriter& cp, const mpm::FieldList& list) {
+void save_fields(io::CheckpointWriter& cp, const mpm::FieldList& list,
+                 const std::function<std::string(const char*)>& units) {
   for (const mpm::PersistentField& f : list.fields()) {
     if (!f.in_checkpoint) continue;
     const std::string name = f.dataset();
+    const std::string unit = units(f.unit);
     std::visit(
         [&](const auto& d) {
           using T = std::decay_t<decltype(d)>;
           if constexpr (std::is_same_v<T, std::span<double>> || std::is_same_v<T, std::span<std::uint8_t>>) {
             using V = std::span<const typename T::value_type>;
             if (f.per_point) {
-              cp.ranks_array(name, V(d));  // (decomposed: every rank's points)
+              cp.ranks_array(name, V(d), unit);  // (decomposed: every rank's points)
             } else {
-              cp.array(name, V(d));
+              cp.array(name, V(d), {}, unit);
             }
           } else if constexpr (std::is_same_v<T, mpm::GrowingSeries>) {
             const std::vector<double> values = d.pack();
-            if (!values.empty()) cp.array(name, values);
+            if (!values.empty()) cp.array(name, values, {}, unit);
           } else if constexpr (std::is_same_v<T, double*> || std::is_same_v<T, std::int64_t*>) {
             cp.attribute(name, *d);
           }

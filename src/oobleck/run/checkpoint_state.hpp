@@ -10,6 +10,9 @@
 //                       "third<k>/impulse_sum"
 //   Snapshots           attribute "next_snapshot" (run/snapshots.hpp)
 //   SceneAnalysis       its samples under "analysis/" and attributes (run/analysis.hpp)
+#include <functional>
+#include <string>
+
 #include "oobleck/io/checkpoint.hpp"
 #include "oobleck/mpm/fields.hpp"
 #include "oobleck/scene/build.hpp"
@@ -24,8 +27,10 @@ mpm::FieldList solver_fields(const scene::BuiltScene<G>& scene);
 /// Write every field of `list` that belongs in a checkpoint: arrays as flat datasets, growing
 /// series when not empty, numbers as attributes. A decomposed run calls it on every rank with
 /// a writer of every rank: the points' arrays hold every rank's points (rank order), the others
-/// are rank 0's.
-void save_fields(io::CheckpointWriter& cp, const mpm::FieldList& list);
+/// are rank 0's. Each dataset's `units` attribute is units(the field's declared unit) (the run
+/// passes in_measure<G>, run/units.hpp).
+void save_fields(io::CheckpointWriter& cp, const mpm::FieldList& list,
+                 const std::function<std::string(const char*)>& units);
 
 /// Read them back in place: an array or attribute the checkpoint lacks, or an array of another
 /// size or type, is an InputError naming the file and the dataset (an array with a

@@ -11,15 +11,16 @@
 #include "oobleck/core/comm.hpp"
 #include "oobleck/mpm/fields.hpp"
 #include "oobleck/run/nodal_fields.hpp"
+#include "oobleck/run/units.hpp"
 
 namespace oobleck::run {
 
 namespace {
 
 /// Storage for a frame's per-field arrays (the frame holds spans into it).
-class Columns {
+class Arrays {
  public:
-  explicit Columns(std::size_t expected) { store_.reserve(expected); }
+  explicit Arrays(std::size_t expected) { store_.reserve(expected); }
   std::vector<double>& add(std::size_t n) {
     store_.emplace_back(n, 0.0);
     return store_.back();
@@ -29,12 +30,13 @@ class Columns {
   std::vector<std::vector<double>> store_;
 };
 
-/// Add field `f` (not the positions) to a frame's point cloud of n points.
-void add_to_cloud(io::PointCloud& cloud, const mpm::PersistentField& f, std::size_t n, Columns& column) {
+/// Add field `f` (not the positions) to a frame's point cloud of n points, in `units`.
+void add_to_cloud(io::PointCloud& cloud, const mpm::PersistentField& f, const std::string& units, std::size_t n,
+                  Arrays& column) {
   const auto* d = std::get_if<std::span<double>>(&f.data);
   const std::string& name = f.shown_as();
   switch (f.frame) {
-    case mpm::FrameForm::vector: cloud.vector(name, f.width, *d); return;
+    case mpm::FrameForm::vector: cloud.vector(name, f.width, *d, units); return;
     case mpm::FrameForm::sym_tensor: {        // 3×3, column-major: (i, j) at i + 3 j
       const int idx[6] = {0, 3, 6, 4, 7, 8};  // xx xy xz yy yz zz
       std::array<std::vector<double>*, 6> c{};
@@ -42,7 +44,7 @@ void add_to_cloud(io::PointCloud& cloud, const mpm::PersistentField& f, std::siz
         c[k] = &column.add(n);
         for (std::size_t p = 0; p < n; ++p) (*c[k])[p] = (*d)[9 * p + static_cast<std::size_t>(idx[k])];
       }
-      cloud.sym_tensor(name, {*c[0], *c[1], *c[2], *c[3], *c[4], *c[5]});
+      cloud.sym_tensor(name, {*c[0], *c[1], *c[2], *c[3], *c[4], *c[5]}, units);
       return;
     }
     default: break;  // scalars
@@ -50,34 +52,37 @@ void add_to_cloud(io::PointCloud& cloud, const mpm::PersistentField& f, std::siz
   if (f.derive) {
     auto& values = column.add(n);
     f.derive(values);
-    cloud.scalar(name, values);
+    cloud.scalar(name, values, units);
   } else if (const auto* u = std::get_if<std::span<std::uint8_t>>(&f.data)) {
     auto& values = column.add(n);
     for (std::size_t p = 0; p < n; ++p) values[p] = (*u)[p];
-    cloud.scalar(name, values);
+    cloud.scalar(name, values, units);
   } else {
-    cloud.scalar(name, *d);
+    cloud.scalar(name, *d, units);
   }
 }
 
-/// Body b's points with the fields that it and its law declare for frames (mpm/fields.hpp).
+/// Body b's points with the fields that it and its law declare for frames (mpm/fields.hpp), each
+/// in its declared unit in the points' measure (in_measure: "kg/rad" in axisymmetric runs).
 template <class G>
-io::PointCloud body_cloud(const scene::BuiltScene<G>& scene, int b, Columns& column) {
+io::PointCloud body_cloud(const scene::BuiltScene<G>& scene, int b, Arrays& column) {
   auto& body = scene.solver->body(b);
   const auto n = static_cast<std::size_t>(body.size());
   mpm::FieldList list;
   body.declare_fields(list);
   if (body.law) body.law->declare_fields(body, list);
   const std::vector<const mpm::PersistentField*> shown = list.frame_fields();  // (positions first)
-  io::PointCloud cloud(body.name, shown.front()->width, std::get<std::span<double>>(shown.front()->data));
-  for (std::size_t k = 1; k < shown.size(); ++k) add_to_cloud(cloud, *shown[k], n, column);
+  io::PointCloud cloud(body.name, shown.front()->width, std::get<std::span<double>>(shown.front()->data),
+                       in_measure<G>(shown.front()->unit));
+  for (std::size_t k = 1; k < shown.size(); ++k)
+    add_to_cloud(cloud, *shown[k], in_measure<G>(shown[k]->unit), n, column);
   return cloud;
 }
 
 /// The solver's nodal frame fields (Solver::declare_grid_fields) on the physical nodes (x
 /// fastest; decomposed: this rank's own box of them); nullopt when it declares none.
 template <class G>
-std::optional<io::NodeGrid> node_grid(const scene::BuiltScene<G>& scene, Columns& column) {
+std::optional<io::NodeGrid> node_grid(const scene::BuiltScene<G>& scene, Arrays& column) {
   constexpr int D = G::dim;
   mpm::FieldList list;
   scene.solver->declare_grid_fields(list);
@@ -118,7 +123,7 @@ std::optional<io::NodeGrid> node_grid(const scene::BuiltScene<G>& scene, Columns
     const auto& stored = std::get<std::span<double>>(f->data);
     auto& values = column.add(at.size());
     for (std::size_t n = 0; n < at.size(); ++n) values[n] = stored[at[n]];
-    ng.scalar(f->shown_as(), values);
+    ng.scalar(f->shown_as(), values, in_measure<G>(f->unit));
   }
   return ng;
 }
@@ -131,31 +136,33 @@ void write_frame(io::FrameWriter& frames, const scene::BuiltScene<G>& scene) {
   io::Frame frame;
   frame.time = solver.time_s();
   frame.step = solver.steps();
-  Columns column(64 * static_cast<std::size_t>(solver.body_count()) + 16);
+  Arrays column(64 * static_cast<std::size_t>(solver.body_count()) + 16);
   for (int b = 0; b < solver.body_count(); ++b) frame.bodies.push_back(body_cloud(scene, b, column));
   if (auto grid = node_grid(scene, column)) frame.grid = std::move(*grid);
   frames.write(frame);
 }
 
 template <class G>
-std::vector<std::string> series_columns(const scene::BuiltScene<G>& scene) {
+Columns series_columns(const scene::BuiltScene<G>& scene) {
   constexpr int D = G::dim, NC = G::ncomp;
   auto& solver = *scene.solver;
-  std::vector<std::string> c = {"time", "step"};
+  Columns c;
+  c.add("time", "s");
+  c.add("step", "1");
   for (int b = 0; b < solver.body_count(); ++b) {
     const std::string& n = solver.body(b).name;
-    c.push_back("kinetic_energy_" + n);
-    for (int k = 0; k < NC; ++k) c.push_back(fmt::format("momentum_{}_{}", n, k));
-    c.push_back("mass_" + n);
-    c.push_back("max_speed_" + n);
+    c.add("kinetic_energy_" + n, in_measure<G>("J"));
+    for (int k = 0; k < NC; ++k) c.add(fmt::format("momentum_{}_{}", n, k), in_measure<G>("N s"));
+    c.add("mass_" + n, in_measure<G>("kg"));
+    c.add("max_speed_" + n, "m/s");
   }
   for (const auto& tb : scene.third) {
     const std::string& n = tb.cfg->name;
-    for (int k = 0; k < D; ++k) c.push_back(fmt::format("centre_{}_{}", n, k));
-    for (int k = 0; k < NC; ++k) c.push_back(fmt::format("contact_force_{}_{}", n, k));
+    for (int k = 0; k < D; ++k) c.add(fmt::format("centre_{}_{}", n, k), "m");
+    for (int k = 0; k < NC; ++k) c.add(fmt::format("contact_force_{}_{}", n, k), in_measure<G>("N"));
     if (tb.motor >= 0) {
-      c.push_back("omega_" + n);
-      c.push_back("motor_torque_" + n);
+      c.add("omega_" + n, "rad/s");
+      c.add("motor_torque_" + n, in_measure<G>("N m"));
     }
   }
   return c;
@@ -201,9 +208,9 @@ std::vector<double> series_row(const scene::BuiltScene<G>& scene) {
   return r;
 }
 
-#define OOBLECK_INSTANTIATE_OUTPUT(G)                                            \
-  template void write_frame(io::FrameWriter&, const scene::BuiltScene<G>&);      \
-  template std::vector<std::string> series_columns(const scene::BuiltScene<G>&); \
+#define OOBLECK_INSTANTIATE_OUTPUT(G)                                       \
+  template void write_frame(io::FrameWriter&, const scene::BuiltScene<G>&); \
+  template Columns series_columns(const scene::BuiltScene<G>&);             \
   template std::vector<double> series_row(const scene::BuiltScene<G>&)
 OOBLECK_INSTANTIATE_OUTPUT(mpm::PlaneStrain);
 OOBLECK_INSTANTIATE_OUTPUT(mpm::Axisymmetric);

@@ -35,10 +35,21 @@ void with_every_point_on_root(mpm::Solver<G>& solver, F&& f) {
 template <class G>
 void write_frame(io::FrameWriter& frames, const scene::BuiltScene<G>& scene);
 
+/// Columns of a CSV file: each name with its unit beside it (for io::SeriesWriter).
+struct Columns {
+  std::vector<std::string> names, units;
+  void add(std::string name, std::string unit) {
+    names.push_back(std::move(name));
+    units.push_back(std::move(unit));
+  }
+};
+
 /// series.csv: time, step; per body its kinetic energy, momentum, mass and largest speed; per
-/// [[body]] entry its centre of mass and contact force, and its motor's ω and torque.
+/// [[body]] entry its centre of mass and contact force, and its motor's ω and torque. Units: SI,
+/// amounts in the points' measure (in_measure: per metre of depth in plane strain, per radian in
+/// axisymmetric runs).
 template <class G>
-std::vector<std::string> series_columns(const scene::BuiltScene<G>& scene);
+Columns series_columns(const scene::BuiltScene<G>& scene);
 /// (Decomposed runs: called on every rank; the row covers every rank's points.)
 template <class G>
 std::vector<double> series_row(const scene::BuiltScene<G>& scene);

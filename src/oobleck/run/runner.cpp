@@ -27,6 +27,7 @@
 #include "oobleck/run/run_summary.hpp"
 #include "oobleck/run/snapshots.hpp"
 #include "oobleck/run/stop.hpp"
+#include "oobleck/run/units.hpp"
 #include "oobleck/run/checkpoint_state.hpp"
 #include "oobleck/scene/build.hpp"
 #include "oobleck/scene/third_bodies.hpp"
@@ -178,13 +179,15 @@ void SceneRun<G>::start(std::optional<io::FrameWriter>& frames, std::optional<io
     // New [time] settings (RunOptions::restart_overrides): a later plain --restart keeps them.
     if (!opt_.restart_overrides.empty())
       io::write_file_atomically(stored_scene_path(opt_.out_dir), cfg_.resolved_toml, "scene copy");
-    series.emplace(io::SeriesWriter::resume(opt_.out_dir + "/series.csv", series_columns(scene_), cp.time()));
+    const Columns columns = series_columns(scene_);
+    series.emplace(io::SeriesWriter::resume(opt_.out_dir + "/series.csv", columns.names, cp.time(), columns.units));
     return;
   }
   decompose();
   if (root) {
     io::write_file_atomically(stored_scene_path(opt_.out_dir), cfg_.resolved_toml, "scene copy");
-    series.emplace(opt_.out_dir + "/series.csv", series_columns(scene_));
+    const Columns columns = series_columns(scene_);
+    series.emplace(opt_.out_dir + "/series.csv", columns.names, columns.units);
   }
   frames.emplace(opt_.out_dir, "frames", writers());
   write_frame(*frames);
@@ -239,7 +242,7 @@ void SceneRun<G>::write_checkpoint() {
   cp.set_config(cfg_.resolved_toml);
   cp.attribute("dt", scene_.dt_s);
   cp.attribute("threads", static_cast<std::int64_t>(solver().threads()));
-  save_fields(cp, state_fields());
+  save_fields(cp, state_fields(), [](const char* unit) { return in_measure<G>(unit); });
   cp.commit();
 }
 

@@ -95,7 +95,22 @@ SnapshotFields Snapshots<G>::write_next() {
       ++next_;
       return s;
     }
-    std::string text = "x,y,u_x,u_y,displacement_x,displacement_y,f,p_grains,phi\n";
+    // The columns with their units: "units: x=m, ..." ends the comment line, then the header.
+    const std::pair<const char*, const char*> columns[] = {{"x", "m"},
+                                                           {"y", "m"},
+                                                           {"u_x", "m/s"},
+                                                           {"u_y", "m/s"},
+                                                           {"displacement_x", "m"},
+                                                           {"displacement_y", "m"},
+                                                           {"f", "1"},
+                                                           {"p_grains", "Pa"},
+                                                           {"phi", "1"}};
+    std::string units = "units: ", header;
+    for (const auto& [name, unit] : columns) {
+      units += fmt::format("{}{}={}", header.empty() ? "" : ", ", name, unit);
+      header += fmt::format("{}{}", header.empty() ? "" : ",", name);
+    }
+    std::string text = header + "\n";
     for (std::size_t j = 0; j < s.u_x.ny; ++j) {
       for (std::size_t i = 0; i < s.u_x.nx; ++i) {
         const std::size_t k = j * s.u_x.nx + i;
@@ -107,8 +122,8 @@ SnapshotFields Snapshots<G>::write_next() {
     }
     io::write_file_atomically(
         out_dir_ + "/" + file_name(next_),
-        fmt::format("# t = {:.9g} s (requested {:.9g} s), step {}\n", solver.time_s(),
-                    cfg_.analysis.snapshot_times_s[static_cast<std::size_t>(next_)], solver.steps()) +
+        fmt::format("# t = {:.9g} s (requested {:.9g} s), step {}; {}\n", solver.time_s(),
+                    cfg_.analysis.snapshot_times_s[static_cast<std::size_t>(next_)], solver.steps(), units) +
             text,
         "snapshot");
     ++next_;
