@@ -5,9 +5,14 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <initializer_list>
 #include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "cli_common.hpp"
 #include "oobleck/core/error.hpp"
@@ -61,6 +66,24 @@ struct MaterialOverrides {
     rheology::validate(p, "command line");
   }
 };
+
+/// A CSV's columns, each with its SI unit (nullptr: a text column). csv_head() gives the comment
+/// line "# units: name=unit, ..." (text columns left out; a parameter set in normalized units,
+/// the Singh presets, gives "normalized" for every dimensional column) and the header line.
+struct CsvColumn {
+  const char* name;
+  const char* unit;
+};
+std::string csv_head(std::initializer_list<CsvColumn> columns, const rheology::Preset& p) {
+  std::vector<std::string> units, names;
+  for (const auto& c : columns) {
+    names.emplace_back(c.name);
+    if (c.unit == nullptr) continue;
+    const bool dimensionless = std::string_view(c.unit) == "1";
+    units.push_back(fmt::format("{}={}", c.name, p.units == "normalized" && !dimensionless ? "normalized" : c.unit));
+  }
+  return fmt::format("# units: {}\n{}\n", fmt::join(units, ", "), fmt::join(names, ","));
+}
 
 void check_phi(double phi) {
   if (!(std::isfinite(phi) && phi > 0.0 && phi < 1.0))
@@ -154,8 +177,24 @@ void shear_command(CLI::App& point) {
 
     io::OutputFile csv(o->out, "--out");
     auto& st = csv.stream();
-    st << "time,strain,shear_rate,shear_stress,granular_shear_stress,granular_pressure,sigma_xy,f,phi,regime,"
-          "gamma_dot_p,I_v,I_m,beta,mu_p,phi_eq,iterations\n";
+    st << csv_head({{"time", "s"},
+                    {"strain", "1"},
+                    {"shear_rate", "1/s"},
+                    {"shear_stress", "Pa"},
+                    {"granular_shear_stress", "Pa"},
+                    {"granular_pressure", "Pa"},
+                    {"sigma_xy", "Pa"},
+                    {"f", "1"},
+                    {"phi", "1"},
+                    {"regime", nullptr},
+                    {"gamma_dot_p", "1/s"},
+                    {"I_v", "1"},
+                    {"I_m", "1"},
+                    {"beta", "1"},
+                    {"mu_p", "1"},
+                    {"phi_eq", "1"},
+                    {"iterations", "1"}},
+                   p);
     for (const auto& x : res.samples) {
       st << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", num(x.time), num(x.strain),
                         num(x.shear_rate), num(x.shear_stress), num(x.granular_shear_stress), num(x.granular_pressure),
@@ -259,8 +298,18 @@ void relax_command(CLI::App& point) {
     }
     io::OutputFile csv(o->out, "--out");
     auto& st = csv.stream();
-    st << "case,G,K_0,time,granular_shear_stress,granular_pressure,f,gamma_dot_p,regime,ode_granular_shear_stress,ode_"
-          "f\n";
+    st << csv_head({{"case", "1"},
+                    {"G", "Pa"},
+                    {"K_0", "1"},
+                    {"time", "s"},
+                    {"granular_shear_stress", "Pa"},
+                    {"granular_pressure", "Pa"},
+                    {"f", "1"},
+                    {"gamma_dot_p", "1/s"},
+                    {"regime", nullptr},
+                    {"ode_granular_shear_stress", "Pa"},
+                    {"ode_f", "1"}},
+                   base);
     for (std::size_t c = 0; c < results.size(); ++c) {
       for (const auto& x : results[c].samples) {
         st << fmt::format("{},{},{},{},{},{},{},{},{},{},{}\n", c, num(results[c].G), num(results[c].K_0), num(x.time),

@@ -38,6 +38,7 @@
 #include <unistd.h>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
@@ -46,6 +47,7 @@
 #include "oobleck/io/output_file.hpp"
 #include "oobleck/run/stop.hpp"
 #include "oobleck/scene/config.hpp"
+#include "oobleck/scene/key_list.hpp"
 
 namespace oobleck::cli {
 namespace {
@@ -230,6 +232,24 @@ void flatten(const nlohmann::ordered_json& j, const std::string& key,
   } else if (j.is_string()) {
     out.emplace_back(key, j.get<std::string>());
   }
+}
+
+/// The unit of a scene key or alias as the scene file's comment gives it ("# [m/s] ..."; "[-]"
+/// is "1"), or "" when it gives none.
+std::string scene_key_unit(const scene::SceneKeyList& keys, const std::string& key) {
+  std::string comment, target = key;  // (an alias's comment, else its key's)
+  for (const auto& a : keys.aliases)
+    if (a.name == key || a.key == key) {
+      comment = a.comment;
+      target = a.key;
+    }
+  for (const auto& k : keys.keys)
+    if (comment.empty() && k.key == target) comment = k.comment;
+  const auto close = comment.find(']');
+  if (comment.empty() || comment.front() != '[' || close == std::string::npos) return {};
+  std::string unit = trim(comment.substr(1, close - 1));
+  if (unit == "-") unit = "1";
+  return unit.find_first_of(",=") == std::string::npos ? unit : std::string();
 }
 
 std::string csv_field(const std::string& s) {
@@ -582,8 +602,14 @@ void Sweep::write_csv() const {
       cells[i][it->second] = value;
     }
   }
+  // "# units: KEY=UNIT, ..." for the varied keys whose unit the scene file's comments give.
+  const scene::SceneKeyList keys = scene::list_scene_keys(o_.scene);
+  std::vector<std::string> units;
+  for (const auto& v : varies_)
+    if (const std::string u = scene_key_unit(keys, v.key); !u.empty()) units.push_back(fmt::format("{}={}", v.key, u));
   io::OutputFile f(o_.out + "/sweep.csv", "--out");
   auto& out = f.stream();
+  out << "# units:" << (units.empty() ? "" : " ") << fmt::format("{}", fmt::join(units, ", ")) << "\n";
   std::string line;
   for (const auto& v : varies_) line += csv_field(v.key) + ",";
   line += "run";

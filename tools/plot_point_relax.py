@@ -19,8 +19,8 @@ def main():
     ap.add_argument("--title", default="")
     a = ap.parse_args()
     cases = {}
-    with open(a.csv) as fh:
-        for row in csv.DictReader(fh):
+    with open(a.csv) as fh:  # (the '# units: ...' line first)
+        for row in csv.DictReader(line for line in fh if not line.startswith("#")):
             cases.setdefault(int(row["case"]), []).append(row)
     fig, ax = plt.subplots(1, 2, figsize=(12, 4.5))
     for c, rows in sorted(cases.items()):

@@ -18,8 +18,8 @@ def main():
     ap.add_argument("--title", default="")
     a = ap.parse_args()
     cols = {}
-    with open(a.csv) as fh:
-        for row in csv.DictReader(fh):
+    with open(a.csv) as fh:  # (the '# units: ...' line first)
+        for row in csv.DictReader(line for line in fh if not line.startswith("#")):
             for k, v in row.items():
                 cols.setdefault(k, []).append(v)
     num = lambda k: [float(x) for x in cols[k]]  # noqa: E731

@@ -36,7 +36,10 @@ ap.add_argument("--group", default=None, help="one line per value of this column
 args = ap.parse_args()
 
 with open(args.csv, newline="") as fh:
-    rows = list(csv.DictReader(fh))
+    lines = fh.readlines()
+while lines and lines[0].startswith("#"):  # the '# units: ...' line
+    lines.pop(0)
+rows = list(csv.DictReader(lines))
 if not rows:
     sys.exit(f"{args.csv}: no rows")
 for col in (args.quantity, args.x, args.group):

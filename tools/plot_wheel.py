@@ -22,6 +22,7 @@ the granular moduli G, K multiplied by 1, 10 and 100; each panel gives E = 9KG/(
 step, and the within-cell scatter of p~ (docs/analysis.md, "Wheel") at that frame and pooled over the
 run, from its summary.json; one colour scale for all panels. Needs h5py (Debian: python3-h5py).
 """
+import csv
 import glob
 import math
 import os
@@ -29,10 +30,19 @@ import re
 import sys
 
 import numpy as np
-from oobleck_plot import load_scene, load_summary, need_file, plt, read_csv, read_snapshot, run_title, save
+from oobleck_plot import load_scene, load_summary, need_file, plt, read_snapshot, run_title, save
 
 PHI_SURFACE = 0.1
 G = 9.81
+
+
+def read_series(path):
+    """series.csv -> dict of column name -> list of floats ('#' lines, the units line, skipped)."""
+    with open(path, newline="") as fh:
+        rows = list(csv.DictReader(line for line in fh if not line.startswith("#")))
+    if not rows:
+        raise SystemExit(f"{path}: no data rows")
+    return {k: [float(r[k]) for r in rows] for k in rows[0].keys()}
 
 
 class Run:
@@ -45,7 +55,7 @@ class Run:
         self.s = load_summary(path, required=False)
         self.scene = load_scene(path)
         series_path = need_file(os.path.join(path, "series.csv"), "the run's time series")
-        cols = read_csv(series_path)
+        cols = read_series(series_path)
         for c in ("time", "centre_wheel_0", "centre_wheel_1", "omega_wheel"):
             if c not in cols:
                 raise SystemExit(f"{series_path}: no column {c!r} (is this a wheel run?)")

@@ -81,7 +81,8 @@ def sweep(scene, vary: dict, jobs: int = 1, out=None, sets=None, threads=None, *
 
     Returns a DataFrame with one row per run: a column per varied key, ``run`` (the folder's name),
     every scalar of the run's summary.json under its dotted key, ``status`` (ok / failed) and
-    ``message``. Failed runs are rows (the command's exit status 3, ``df.attrs["returncode"]``);
+    ``message``; ``df.attrs["units"]`` holds the units that sweep.csv's first line gives ({column: unit}).
+    Failed runs are rows (the command's exit status 3, ``df.attrs["returncode"]``);
     check=True raises NumericalError instead. Bad input raises InputError with the command's
     message. Ctrl-C stops the running runs with checkpoints (calling again resumes) and raises
     KeyboardInterrupt.
@@ -137,8 +138,17 @@ def sweep(scene, vary: dict, jobs: int = 1, out=None, sets=None, threads=None, *
         raise NumericalError(f"oobleck sweep failed (exit {returncode}): {message}")
     if returncode == 3 and check:
         raise NumericalError(message)
-    df = pd.read_csv(Path(out) / "sweep.csv", float_precision="round_trip", keep_default_na=False,
-                     na_values=[""])
+    path = Path(out) / "sweep.csv"
+    units, comments = {}, 0  # the leading '# units: name=unit, ...' line
+    with open(path) as fh:
+        for line in fh:
+            if not line.startswith("#"):
+                break
+            comments += 1
+            if line.startswith("# units:"):
+                units.update(item.strip().split("=", 1) for item in line[len("# units:"):].split(",") if "=" in item)
+    df = pd.read_csv(path, skiprows=comments, float_precision="round_trip", keep_default_na=False, na_values=[""])
+    df.attrs["units"] = units
     df.attrs["out"] = os.fspath(out)
     df.attrs["returncode"] = returncode
     return df

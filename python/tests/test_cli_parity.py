@@ -10,7 +10,7 @@ import oobleck
 
 
 def read(path):
-    return pd.read_csv(path, float_precision="round_trip")
+    return pd.read_csv(path, comment="#", float_precision="round_trip")  # (point CSVs: a '# units:' line first)
 
 
 def assert_same(py, csv):

@@ -32,6 +32,9 @@ def test_sweep_grid_as_dataframe(root, tmp_path, exe):
     assert df["d"].tolist() == [1e-4, 2e-4, 1e-4, 2e-4]
     assert df["run"].tolist() == ["phi=0.2_d=0.0001", "phi=0.2_d=0.0002", "phi=0.3_d=0.0001", "phi=0.3_d=0.0002"]
     assert (df["status"] == "ok").all()
+    # sweep.csv's units line: d is material.granular.d, "# [m]" in settling.toml (phi has no unit comment)
+    assert (out / "sweep.csv").read_text().startswith("# units: d=m\n")
+    assert df.attrs["units"] == {"d": "m"}
     for _, row in df.iterrows():
         s = json.loads((out / row["run"] / "summary.json").read_text())
         assert row["settling_velocity"] == s["settling_velocity"]  # round trip exact

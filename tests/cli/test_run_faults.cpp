@@ -35,12 +35,14 @@ namespace {
 
 const std::string kSettling = std::string(OOBLECK_SOURCE_DIR) + "/scenes/verification/settling.toml";
 
-/// Wait (up to 60 s) until `path` exists and holds at least `lines` lines.
+/// Wait (up to 60 s) until `path` exists and holds at least `lines` lines besides its '#' lines
+/// (the units line).
 bool wait_for_lines(const std::string& path, int lines) {
   for (int k = 0; k < 6000; ++k) {
     std::ifstream in(path);
     int n = 0;
-    for (std::string l; std::getline(in, l);) ++n;
+    for (std::string l; std::getline(in, l);)
+      if (!l.starts_with('#')) ++n;
     if (n >= lines) return true;
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }

@@ -2,6 +2,7 @@
 // time, well under a second each), their folders and sweep.csv; a rerun skips complete runs and
 // continues one that holds a checkpoint; a failed run is a row and exit 3; SIGINT reaches the
 // runs, which leave checkpoints; bad --vary specs and other bad input exit 2 with nothing written.
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
@@ -33,9 +34,11 @@ const std::string kSettling = std::string(OOBLECK_SOURCE_DIR) + "/scenes/verific
 const std::string kShort =
     " --set analysis.average_from=0.001 --set output.frame_interval=0.001 --threads 1 --set time.duration=0.002";
 
-/// A CSV file (RFC 4180 quoting) as rows of cells; row 0 is the header.
+/// A CSV file (RFC 4180 quoting) as rows of cells; row 0 is the header (leading '#' lines, the
+/// units line, skipped).
 std::vector<std::vector<std::string>> read_csv(const std::string& path) {
-  const std::string text = read_text(path);
+  std::string text = read_text(path);
+  while (text.starts_with('#')) text.erase(0, std::min(text.size(), text.find('\n') + 1));
   std::vector<std::vector<std::string>> rows(1);
   std::string cell;
   bool quoted = false;
@@ -120,6 +123,8 @@ TEST(SweepCli, GridOfRunsTabulatesEverySummaryScalarAndARerunSkipsCompleteRuns) 
   }
 
   const auto check_table = [&](const std::string& message) {
+    // The units line: d is material.granular.d, "# [m]" in settling.toml (phi has no unit comment).
+    EXPECT_TRUE(read_text(out + "/sweep.csv").starts_with("# units: d=m\nphi,d,run,"));
     const auto rows = read_csv(out + "/sweep.csv");
     ASSERT_EQ(rows.size(), 5u);
     const auto& h = rows[0];

@@ -66,8 +66,10 @@ TEST(PointCli, ShearAndRelaxWriteCsv) {
   ASSERT_EQ(r.status, 0) << r.output;
   {
     std::ifstream in(out);
-    std::string header;
+    std::string units, header;
+    std::getline(in, units);  // "# units: time=s, ..." (the text column regime left out)
     std::getline(in, header);
+    EXPECT_EQ(units.rfind("# units: time=s, strain=1, shear_rate=1/s, shear_stress=Pa, ", 0), 0u) << units;
     EXPECT_EQ(
         header.rfind(
             "time,strain,shear_rate,shear_stress,granular_shear_stress,granular_pressure,sigma_xy,f,phi,regime", 0),
@@ -80,8 +82,12 @@ TEST(PointCli, ShearAndRelaxWriteCsv) {
           out);
   ASSERT_EQ(r.status, 0) << r.output;
   std::ifstream in(out);
-  std::string header;
+  std::string units, header;
+  std::getline(in, units);
   std::getline(in, header);
+  EXPECT_EQ(units,
+            "# units: case=1, G=Pa, K_0=1, time=s, granular_shear_stress=Pa, granular_pressure=Pa, f=1, "
+            "gamma_dot_p=1/s, ode_granular_shear_stress=Pa, ode_f=1");
   EXPECT_EQ(
       header,
       "case,G,K_0,time,granular_shear_stress,granular_pressure,f,gamma_dot_p,regime,ode_granular_shear_stress,ode_f");
