@@ -22,6 +22,7 @@
 #include <unistd.h>
 
 #include "cli_common.hpp"
+#include "cmd_fit.hpp"
 #include "oobleck/core/error.hpp"
 #include "oobleck/io/csv.hpp"
 #include "oobleck/io/output_file.hpp"
@@ -257,6 +258,38 @@ io::CsvTable curves_table(const std::vector<Export>& exports, const std::string&
   }
   return t;
 }
+
+}  // namespace
+
+FlowCurveData read_flow_curve_data(const CLI::App& cmd, const CLI::Option* data, const CLI::Option* step,
+                                   const std::vector<std::string>& files, const std::vector<std::string>& steps,
+                                   const std::vector<double>& phi, bool quiet) {
+  // --data FILE [--step S] --phi PHI per volume fraction: a --step belongs to the --data before it.
+  std::vector<Export> exports;
+  std::string args;
+  if (!phi.empty() || files.size() > 1 || step->count() > 0) {
+    if (phi.size() != files.size())
+      throw InputError(
+          fmt::format("--data given {} times and --phi {} times: give one --phi (the volume fraction) "
+                      "per --data export, e.g. --data a.txt --phi 0.40 --data b.txt --phi 0.44",
+                      files.size(), phi.size()));
+    std::string every;
+    std::vector<std::string> of_file(files.size());
+    std::size_t k = 0, j = 0;
+    for (const CLI::Option* opt : cmd.parse_order()) {
+      if (opt == data) ++k;
+      if (opt == step && j < steps.size()) (k == 0 ? every : of_file[k - 1]) = steps[j++];
+    }
+    for (std::size_t i = 0; i < files.size(); ++i) {
+      exports.push_back({files[i], of_file[i].empty() ? every : of_file[i], phi[i]});
+      args += fmt::format("{}--data {}{} --phi {}", i ? " " : "", files[i],
+                          exports.back().step.empty() ? "" : fmt::format(" --step '{}'", exports.back().step), phi[i]);
+    }
+  }
+  return {curves_table(exports, fmt::format("{}", fmt::join(files, ", ")), quiet), args};
+}
+
+namespace {
 
 /// `--kind curves --plot`: the data (with the model's value and the residual per point) and the
 /// fitted flow curves at each data phi (every branch, 300 points, cut to the data's stress range
@@ -500,29 +533,6 @@ void add_fit_command(CLI::App& rheology) {
     o->data = fmt::format("{}", fmt::join(o->files, ", "));
     if (o->kind == "curves") {
       if (terms->count() > 0) throw InputError(fmt::format("--terms = {}: only for --kind dst (not curves)", o->terms));
-      // --data FILE [--step S] --phi PHI per volume fraction: a --step belongs to the --data before it.
-      std::vector<Export> exports;
-      std::string args;
-      if (!o->phi.empty() || o->files.size() > 1 || step->count() > 0) {
-        if (o->phi.size() != o->files.size())
-          throw InputError(
-              fmt::format("--data given {} times and --phi {} times: give one --phi (the volume fraction) "
-                          "per --data export, e.g. --data a.txt --phi 0.40 --data b.txt --phi 0.44",
-                          o->files.size(), o->phi.size()));
-        std::string every;
-        std::vector<std::string> of_file(o->files.size());
-        std::size_t k = 0, j = 0;
-        for (const CLI::Option* opt : cmd->parse_order()) {
-          if (opt == data) ++k;
-          if (opt == step && j < o->steps.size()) (k == 0 ? every : of_file[k - 1]) = o->steps[j++];
-        }
-        for (std::size_t i = 0; i < o->files.size(); ++i) {
-          exports.push_back({o->files[i], of_file[i].empty() ? every : of_file[i], o->phi[i]});
-          args += fmt::format("{}--data {}{} --phi {}", i ? " " : "", o->files[i],
-                              exports.back().step.empty() ? "" : fmt::format(" --step '{}'", exports.back().step),
-                              o->phi[i]);
-        }
-      }
       const bool default_base = o->params.preset.empty() && o->params.params.empty();
       std::string note;
       if (default_base) {
@@ -531,9 +541,9 @@ void add_fit_command(CLI::App& rheology) {
         fmt::print(o->json ? stderr : stdout, "{}\n", note);
       }
       const rheology::Preset base = o->params.load(kDefaultPreset);
-      const io::CsvTable table = curves_table(exports, o->data, o->json);
-      fit_curves_command({o->data, o->out, o->parameters, o->residual, o->png, o->json, o->strict, args}, table, base,
-                         note);
+      const FlowCurveData d = read_flow_curve_data(*cmd, data, step, o->files, o->steps, o->phi, o->json);
+      fit_curves_command({o->data, o->out, o->parameters, o->residual, o->png, o->json, o->strict, d.args}, d.table,
+                         base, note);
       return;
     }
     for (auto* opt : {parameters, residual, strict}) {

@@ -6,11 +6,14 @@
 #include <filesystem>
 #include <sstream>
 
+#include <unistd.h>
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
+#include "cmd_fit.hpp"
 #include "oobleck/core/error.hpp"
 #include "oobleck/io/output_file.hpp"
 #include "oobleck/io/rheometer.hpp"
@@ -21,31 +24,150 @@
 namespace oobleck::cli {
 namespace {
 
+/// "LO,HI" of --xlim/--ylim: 0 < LO < HI, finite (log axes); a usage error otherwise.
+std::string parse_limits(const std::string& text, const std::string& option) {
+  const auto comma = text.find(',');
+  double lo = NAN, hi = NAN;
+  if (comma != std::string::npos) {
+    try {
+      std::size_t n1 = 0, n2 = 0;
+      const std::string a = text.substr(0, comma), b = text.substr(comma + 1);
+      lo = std::stod(a, &n1);
+      hi = std::stod(b, &n2);
+      if (n1 != a.size() || n2 != b.size()) lo = hi = NAN;
+    } catch (const std::exception&) {
+      lo = hi = NAN;
+    }
+  }
+  if (!(std::isfinite(lo) && std::isfinite(hi) && lo > 0.0 && lo < hi)) {
+    throw CLI::ValidationError(
+        option,
+        fmt::format("'{}': must be LO,HI with 0 < LO < HI (the axes are logarithmic), e.g. {} 1e-3,1e2", text, option));
+  }
+  return fmt::format("{},{}", num(lo), num(hi));
+}
+
+/// The `# units: ...` first line of the flow-curve CSV (SI, or the normalized units of the Singh sets).
+std::string flow_curve_units(const rheology::Preset& p) {
+  const bool si = p.units != "normalized";
+  const std::string rate = si ? "1/s" : "gamma_dot_0", stress = si ? "Pa" : "eta_0 gamma_dot_0",
+                    visc = si ? "Pa s" : "eta_0";
+  return fmt::format(
+      "# units: phi=1, f=1, shear_rate={0}, shear_stress={1}, granular_pressure={1}, granular_shear_stress={1}, "
+      "viscosity={2}, eta_r=1, shear_rate_dst={0}; parameters {3} ({4} units)\n",
+      rate, stress, visc, p.name, p.units);
+}
+
 void flow_curve_command(CLI::App& rheology) {
-  auto* cmd = rheology.add_subcommand("flow-curve", "steady flow curves tau(gamma_dot) with every branch (E11)");
+  auto* cmd = rheology.add_subcommand(
+      "flow-curve",
+      "steady flow curves tau(gamma_dot) with every branch (E11), written as CSV and/or plotted, optionally "
+      "over measured data (--data)");
   struct Opts {
     ParamsOption params;
     std::vector<double> phi;
     int points = 400;
-    std::string out, png;
+    std::string out, png, x = "rate", y = "stress", xlim, ylim;
+    std::vector<std::string> files, steps;
   };
   auto o = std::make_shared<Opts>();
   o->params.add_to(cmd);
-  cmd->add_option("--phi", o->phi, "volume fraction(s), 0 < phi < phi_j (repeat for several)")->required();
+  cmd->add_option("--phi", o->phi,
+                  "volume fraction(s), 0 < phi < phi_j (repeat for several); with --data: the volume fraction of "
+                  "each --data file without a phi column (one per --data, as `rheology fit`)");
   cmd->add_option("--points", o->points, "points per curve (>= 2)")->capture_default_str();
-  cmd->add_option("--out", o->out, "output CSV file")->required();
-  cmd->add_option("--plot", o->png, "also plot tau vs gamma_dot to this PNG");
-  cmd->callback([o] {
+  cmd->add_option("--out", o->out, "output CSV file (at least one of --out and --plot)");
+  cmd->add_option("--plot", o->png, "plot the curves to this PNG (at least one of --out and --plot)");
+  auto* data = cmd->add_option("--data", o->files,
+                               "measured flow curves to draw as points over the model at their volume fractions: a "
+                               "CSV with columns phi, shear_rate [1/s], shear_stress [Pa], or an instrument export "
+                               "(TRIOS, RheoCompass, rSpace, CSV with units) followed by --phi, as `rheology fit "
+                               "--kind curves` reads it; needs --plot");
+  auto* step = cmd->add_option("--step", o->steps,
+                               "the export's step, NAME or 1-based INDEX (after a --data for that file, before the "
+                               "first --data for all; default: the one step with shear rate and stress)");
+  auto* x = cmd->add_option("--x", o->x, "plot's horizontal axis: rate (shear rate) or stress (shear stress)")
+                ->check(CLI::IsMember({"rate", "stress"}))
+                ->capture_default_str();
+  auto* y = cmd->add_option("--y", o->y, "plot's vertical axis: stress (shear stress) or viscosity (tau/gamma_dot)")
+                ->check(CLI::IsMember({"stress", "viscosity"}))
+                ->capture_default_str();
+  auto* xlim = cmd->add_option("--xlim", o->xlim,
+                               "plot's horizontal range LO,HI (default: the data's span with --data, else the "
+                               "model's from 1e-2 to 1e4 tau*)");
+  auto* ylim = cmd->add_option("--ylim", o->ylim, "plot's vertical range LO,HI (default: as --xlim)");
+  cmd->callback([o, cmd, data, step, x, y, xlim, ylim] {
+    // Usage first (exit 1): what to write, and options that only draw.
+    if (o->out.empty() && o->png.empty()) {
+      throw CLI::ValidationError("--out/--plot", "give --out CSV, --plot PNG or both (nothing to write)");
+    }
+    if (o->png.empty()) {
+      for (const CLI::Option* opt : {data, step, x, y, xlim, ylim}) {
+        if (opt->count() > 0) throw CLI::ValidationError(opt->get_name(), "draws on the plot: give --plot PNG");
+      }
+    }
+    if (o->x == "stress" && o->y == "stress") {
+      throw CLI::ValidationError("--x",
+                                 "--x stress with --y stress draws the stress against itself: use --y viscosity");
+    }
+    if (step->count() > 0 && data->count() == 0) throw CLI::ValidationError("--step", "only with --data");
+    const std::string xl = o->xlim.empty() ? "" : parse_limits(o->xlim, "--xlim");
+    const std::string yl = o->ylim.empty() ? "" : parse_limits(o->ylim, "--ylim");
+    if (o->files.empty() && o->phi.empty()) {
+      throw CLI::ValidationError("--phi", "give the volume fraction(s) of the curves: --phi PHI (or --data FILE)");
+    }
+
     const rheology::Preset p = o->params.load();
     if (o->points < 2) throw InputError(fmt::format("--points = {}: must be >= 2", o->points));
-    for (double phi : o->phi) rheology::validate_phi(p.steady, phi, fmt::format("--phi (parameters: {})", p.file));
-    io::check_writable(o->out, "--out");
+    FlowCurveData measured;
+    std::vector<double> phis = o->phi;
+    if (!o->files.empty()) {
+      measured = read_flow_curve_data(*cmd, data, step, o->files, o->steps, o->phi, false);
+      const io::CsvTable& t = measured.table;
+      for (const char* c : {"phi", "shear_rate", "shear_stress"}) {
+        if (!t.has_column(c)) {
+          throw InputError(fmt::format(
+              "{}: missing column '{}' (columns present: {}); --data needs phi,shear_rate,shear_stress (or an "
+              "instrument export with --phi)",
+              t.file, c, fmt::join(t.header, ", ")));
+        }
+      }
+      phis = t.column("phi");
+      const std::vector<double> rate = t.column("shear_rate"), stress = t.column("shear_stress");
+      for (std::size_t k = 0; k < phis.size(); ++k) {
+        if (!(rate[k] > 0.0 && stress[k] > 0.0 && std::isfinite(rate[k]) && std::isfinite(stress[k]))) {
+          throw InputError(fmt::format("{}: data row {}: shear_rate = {}, shear_stress = {}: must be positive", t.file,
+                                       k + 1, rate[k], stress[k]));
+        }
+      }
+      std::sort(phis.begin(), phis.end());
+      phis.erase(std::unique(phis.begin(), phis.end()), phis.end());
+    }
+    for (double phi : phis) {
+      rheology::validate_phi(p.steady, phi, fmt::format("--phi (parameters: {})", p.file));
+    }
+    if (!o->out.empty()) io::check_writable(o->out, "--out");
     if (!o->png.empty()) io::check_writable(o->png, "--plot");
 
-    io::OutputFile csv(o->out, "--out");
+    // The model's CSV: --out, or a temporary for the plot alone.
+    namespace fs = std::filesystem;
+    const fs::path tmp_dir = fs::temp_directory_path();
+    const std::string stem = fmt::format("oobleck-flow-curve-{}", ::getpid());
+    const std::string curves_csv = o->out.empty() ? (tmp_dir / (stem + "-model.csv")).string() : o->out;
+    const std::string data_csv = (tmp_dir / (stem + "-data.csv")).string();
+    struct Cleanup {
+      std::vector<std::string> files;
+      ~Cleanup() {
+        std::error_code ec;
+        for (const auto& f : files) fs::remove(f, ec);
+      }
+    } cleanup;
+    if (o->out.empty()) cleanup.files.push_back(curves_csv);
+    io::OutputFile csv(curves_csv, o->out.empty() ? "plot curves" : "--out");
     auto& s = csv.stream();
+    s << flow_curve_units(p);
     s << "phi,f,shear_rate,shear_stress,granular_pressure,granular_shear_stress,viscosity,eta_r,shear_rate_dst\n";
-    for (double phi : o->phi) {
+    for (double phi : phis) {
       const auto dst = rheology::shear_rate_dst(p.steady, phi);
       const std::string dst_s = dst ? num(*dst) : "nan";
       for (const auto& pt : rheology::flow_curve(p.steady, phi, o->points)) {
@@ -55,11 +177,29 @@ void flow_curve_command(CLI::App& rheology) {
       }
     }
     csv.commit();
-    fmt::print("wrote {} ({} curves x {} points; parameters {} [{} units])\n", o->out, o->phi.size(), o->points, p.name,
-               p.units);
+    if (!o->out.empty()) {
+      fmt::print("wrote {} ({} curves x {} points; parameters {} [{} units])\n", o->out, phis.size(), o->points, p.name,
+                 p.units);
+    }
     if (!o->png.empty()) {
-      std::vector<std::string> args = {o->out, "--title", fmt::format("{} ({} units)", p.name, p.units)};
+      std::vector<std::string> args = {
+          curves_csv, "--title", fmt::format("{} ({} units)", p.name, p.units), "--x", o->x, "--y", o->y};
       if (p.units == "normalized") args.emplace_back("--normalized");
+      if (!xl.empty()) args.insert(args.end(), {"--xlim", xl});
+      if (!yl.empty()) args.insert(args.end(), {"--ylim", yl});
+      if (!o->files.empty()) {
+        const io::CsvTable& t = measured.table;
+        const std::vector<double> phi = t.column("phi"), rate = t.column("shear_rate"),
+                                  stress = t.column("shear_stress");
+        std::string d = "# units: phi=1, shear_rate=1/s, shear_stress=Pa; measured: " + t.file + "\n";
+        d += "phi,shear_rate,shear_stress\n";
+        for (std::size_t k = 0; k < phi.size(); ++k)
+          d += fmt::format("{},{},{}\n", num(phi[k]), num(rate[k]), num(stress[k]));
+        cleanup.files.push_back(data_csv);
+        io::write_file_atomically(data_csv, d, "plot data");
+        args.insert(args.end(), {"--data", data_csv, "--data-label", t.file});
+        fmt::print("data: {}: {} points at phi = {}\n", t.file, phi.size(), fmt::join(phis, ", "));
+      }
       plot("plot_flow_curves.py", args, o->png);
       fmt::print("wrote {}\n", o->png);
     }
@@ -133,6 +273,8 @@ void structure_command(CLI::App& rheology) {
     io::check_writable(o->out, "--out");
     if (!o->png.empty()) io::check_writable(o->png, "--plot");
     io::OutputFile csv(o->out, "--out");
+    csv.stream() << fmt::format("# units: stress={}, f_model=1, f_wyart_cates=1, f_singh=1; parameters {} ({} units)\n",
+                                p.units == "normalized" ? "eta_0 gamma_dot_0" : "Pa", p.name, p.units);
     csv.stream() << "stress,f_model,f_wyart_cates,f_singh\n";
     const double ts = p.steady.tau_star;
     for (int k = 0; k < o->points; ++k) {

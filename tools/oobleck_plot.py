@@ -9,9 +9,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 
 def read_csv(path):
-    """Read a CSV with a header into a dict of column name -> list of floats."""
+    """Read a CSV with a header into a dict of column name -> list of floats; lines starting with
+    '#' (the `# units: ...` line oobleck writes first) are skipped."""
     with open(path, newline="") as fh:
-        rows = list(csv.DictReader(fh))
+        rows = list(csv.DictReader(line for line in fh if not line.startswith("#")))
     if not rows:
         raise SystemExit(f"{path}: no data rows")
     return {k: [float(r[k]) for r in rows] for k in rows[0].keys()}

@@ -431,37 +431,80 @@ class FitResult:
             lines.append(f"  {k:<16} held at the base value ({reason})")
         return "\n".join(lines)
 
-    def plot(self, ax=None):
+    def plot(self, ax=None, y: str = "stress", x: str = "rate"):
         """Data and fitted model on a matplotlib Axes (created when None); returns the Axes.
-        curves: shear stress [Pa] vs shear rate [1/s] per phi, log-log, points = data, lines = the
-        fitted flow curves (every branch); low/high: relative viscosity vs phi; dst: DST rate vs phi."""
+
+        curves: per phi (one colour, one legend entry each), the data as markers and the fitted flow
+        curve as lines, every branch (unstable ones, where the rate falls as the stress rises,
+        dotted), log-log: ``y='stress'`` (default) or ``'viscosity'`` (tau/gamma_dot) against
+        ``x='rate'`` (default; the DST rate, E14, dashed) or ``'stress'``; the axes span the data
+        (``ax.set_xlim``/``set_ylim`` afterwards to change them). low/high: relative viscosity vs
+        phi; dst: DST rate vs phi (x and y must keep their defaults there). The same picture as
+        ``oobleck rheology flow-curve --params FIT.toml --data DATA --plot P.png [--x] [--y]``."""
         import matplotlib.pyplot as plt
+        from matplotlib.lines import Line2D
+        if y not in ("stress", "viscosity"):
+            raise InputError(f"y = {y!r}: must be 'stress' or 'viscosity'")
+        if x not in ("rate", "stress"):
+            raise InputError(f"x = {x!r}: must be 'rate' or 'stress'")
+        if x == "stress" and y == "stress":
+            raise InputError("x = 'stress' with y = 'stress' draws the stress against itself: use y='viscosity'")
+        if self.kind != "curves" and (x, y) != ("rate", "stress"):
+            raise InputError(f"x, y: only for kind 'curves' (not {self.kind!r})")
         if ax is None:
-            _, ax = plt.subplots(figsize=(6, 4.5))
+            _, ax = plt.subplots(figsize=(7.5, 4.8))
         d = self.residuals
         if self.kind == "curves":
+            def axes(rate, stress):
+                rate, stress = np.asarray(rate, dtype=float), np.asarray(stress, dtype=float)
+                return (rate if x == "rate" else stress), (stress if y == "stress" else stress / rate)
+
             phis = sorted(d["phi"].unique())
             colors = plt.cm.viridis(np.linspace(0, 0.9, len(phis)))
+            handles, xs, ys = [], [], []
             for phi, c in zip(phis, colors):
                 sel = d[d["phi"] == phi]
-                ax.loglog(sel["shear_rate"], sel["shear_stress"], "o", color=c, ms=4, label=f"phi = {phi:g}")
-                fc = flow_curve(self.params, phi, 300)
-                lo, hi = sel["shear_stress"].min() / 3, sel["shear_stress"].max() * 3
-                fc = fc[(fc["shear_stress"] > lo) & (fc["shear_stress"] < hi)]
-                ax.loglog(fc["shear_rate"], fc["shear_stress"], "-", color=c, lw=1.2)
-            ax.set_xlabel("shear rate [1/s]")
-            ax.set_ylabel("shear stress [Pa]")
-        else:
-            col = "shear_rate_dst" if self.kind == "dst" else "value"
-            y = d[col] if col in d else d["model"] * np.exp(-d["residual"])
-            ax.semilogy(d["phi"], y, "o", label="data")
-            phi_m = self.params.phi_c if self.kind == "high" else self.params.phi_j
-            lo = self.params.phi_c if self.kind == "dst" else d["phi"].min() - 0.05 * (phi_m - d["phi"].min())
-            grid = phi_m - (phi_m - lo) * np.geomspace(1, 1e-3, 300)
-            model = [_core.fit_model_value(self.kind, self.params, float(x)) for x in grid]
-            ax.semilogy(grid, model, "-", label=f"fit --kind {self.kind}")
-            ax.set_xlabel("phi [-]")
-            ax.set_ylabel("gamma_dot_DST [1/s]" if self.kind == "dst" else "relative viscosity [-]")
+                xd, yd = axes(sel["shear_rate"], sel["shear_stress"])
+                xs.append(xd)
+                ys.append(yd)
+                ax.loglog(xd, yd, "o", color=c, ms=5, mec="k", mew=0.5, zorder=3)
+                fc = flow_curve(self.params, float(phi), 400, as_frame=False)
+                g, t = fc["shear_rate"], fc["shear_stress"]
+                xm, ym = axes(g, t)
+                rising = np.diff(g) >= 0  # stable where the rate rises with the stress
+                start = 0
+                for i in range(1, len(rising) + 1):
+                    if i == len(rising) or rising[i] != rising[start]:
+                        ok = bool(rising[start])
+                        ax.loglog(xm[start:i + 1], ym[start:i + 1], color=c, lw=1.8 if ok else 1.0,
+                                  ls="-" if ok else ":")
+                        start = i
+                dst = shear_rate_dst(self.params, float(phi))
+                if dst is not None and x == "rate":
+                    ax.axvline(dst, color=c, ls="--", lw=0.8)
+                handles.append(Line2D([], [], color=c, lw=1.8, marker="o", ms=5, mec="k", mew=0.5,
+                                      label=f"φ = {phi:.4g}  ({len(sel)} points)"))
+            xs, ys = np.concatenate(xs), np.concatenate(ys)
+            ax.set_xlim(xs.min() / 1.6, xs.max() * 1.6)
+            ax.set_ylim(ys.min() / 1.6, ys.max() * 1.6)
+            ax.set_xlabel("shear rate γ̇ [1/s]" if x == "rate" else "shear stress τ [Pa]")
+            ax.set_ylabel("shear stress τ [Pa]" if y == "stress" else "viscosity η = τ/γ̇ [Pa s]")
+            notes = "points: data; lines: fit, every branch (dotted: unstable)" + ("; dashed: γ̇_DST" if x == "rate" else "")
+            held = f"; held: {', '.join(n for n, _ in self.held)}" if self.held else ""
+            ax.set_title(f"oobleck fit (curves): rms log residual {self.rms:.3g}{held}\n{notes}", fontsize=9)
+            ax.legend(handles=handles, fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+            ax.grid(True, which="major", alpha=0.3)
+            return ax
+        col = "shear_rate_dst" if self.kind == "dst" else "value"
+        y = d[col] if col in d else d["model"] * np.exp(-d["residual"])
+        ax.semilogy(d["phi"], y, "o", label="data")
+        phi_m = self.params.phi_c if self.kind == "high" else self.params.phi_j
+        lo = self.params.phi_c if self.kind == "dst" else d["phi"].min() - 0.05 * (phi_m - d["phi"].min())
+        grid = phi_m - (phi_m - lo) * np.geomspace(1, 1e-3, 300)
+        model = [_core.fit_model_value(self.kind, self.params, float(x)) for x in grid]
+        ax.semilogy(grid, model, "-", label=f"fit --kind {self.kind}")
+        ax.set_xlabel("phi [-]")
+        ax.set_ylabel("gamma_dot_DST [1/s]" if self.kind == "dst" else "relative viscosity [-]")
         ax.set_title(f"oobleck fit ({self.kind}): rms log residual {self.rms:.3g}")
         ax.legend(fontsize=7)
         return ax

@@ -157,6 +157,15 @@ def test_plot():
     import matplotlib
     matplotlib.use("Agg")
     truth = oobleck.load_params("singh2018b")
-    r = oobleck.fit("curves", synthetic(truth, CASES["singh2018b"][1]), start_from(truth))
+    data = synthetic(truth, CASES["singh2018b"][1])
+    r = oobleck.fit("curves", data, start_from(truth))
     ax = r.plot()
-    assert len(ax.lines) == 2 * 4
+    # one marker series per phi holding that phi's data, as given
+    markers = [line for line in ax.lines if line.get_marker() == "o"]
+    assert len(markers) == 4
+    for line, (phi, rows) in zip(markers, data.groupby("phi")):
+        np.testing.assert_array_equal(line.get_xdata(), rows["shear_rate"].to_numpy())
+        np.testing.assert_array_equal(line.get_ydata(), rows["shear_stress"].to_numpy())
+    assert len(ax.get_legend().get_texts()) == 4  # one entry per phi
+    lo, hi = ax.get_xlim()  # the data's span
+    assert lo < data["shear_rate"].min() < data["shear_rate"].max() < hi < 2 * data["shear_rate"].max()

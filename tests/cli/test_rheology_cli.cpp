@@ -1,5 +1,7 @@
 // The `oobleck rheology` CLI contract: file formats, JSON shape, and bad input -> clear message,
 // non-zero exit, no output file created or overwritten.
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -9,6 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
+#include "oobleck/rheology/params.hpp"
+#include "oobleck/rheology/steady_states.hpp"
 
 namespace fs = std::filesystem;
 using clitest::run;
@@ -20,7 +24,13 @@ TEST(RheologyCli, FlowCurveCsvHasContractColumnsAndOrderedRows) {
   const auto r = run("rheology flow-curve --preset hermes2016 --phi 0.40 --phi 0.47 --points 50 --out " + d / "fc.csv");
   ASSERT_EQ(r.status, 0) << r.output;
   std::ifstream in(d / "fc.csv");
-  std::string header;
+  std::string units, header;
+  std::getline(in, units);  // one comment line with the units, then the columns
+  EXPECT_EQ(units.rfind("# units: phi=1, f=1, shear_rate=1/s, shear_stress=Pa, granular_pressure=Pa, "
+                        "granular_shear_stress=Pa, viscosity=Pa s, eta_r=1, shear_rate_dst=1/s; parameters hermes2016",
+                        0),
+            0u)
+      << units;
   std::getline(in, header);
   for (const char* col :
        {"phi", "f", "shear_rate", "shear_stress", "granular_pressure", "granular_shear_stress", "viscosity"}) {
@@ -65,7 +75,130 @@ TEST(RheologyCli, VolumeFractionAndStructure) {
   clitest::TempDir d;
   r = run("rheology structure --preset singh2018a --points 20 --out " + d / "f.csv");
   ASSERT_EQ(r.status, 0) << r.output;
-  EXPECT_EQ(read_text(d / "f.csv").rfind("stress,f_model,f_wyart_cates,f_singh\n", 0), 0u);
+  const std::string text = read_text(d / "f.csv");
+  EXPECT_EQ(text.rfind("# units: stress=eta_0 gamma_dot_0, f_model=1, f_wyart_cates=1, f_singh=1; parameters "
+                       "singh2018a (normalized units)\nstress,f_model,f_wyart_cates,f_singh\n",
+                       0),
+            0u)
+      << text.substr(0, 200);
+}
+
+/// The measured points of hermes2016 at phi 0.40 and 0.47 (rates below DST), 6 per phi.
+std::string hermes_points() {
+  const auto p = oobleck::rheology::load_preset("hermes2016").steady;
+  std::string csv = "# units: phi=1, shear_rate=1/s, shear_stress=Pa\nphi,shear_rate,shear_stress\n";
+  for (double phi : {0.40, 0.47}) {
+    for (int k = 0; k < 6; ++k) {
+      const double rate = 0.01 * std::pow(10.0, 0.4 * k);
+      const auto s = oobleck::rheology::steady_states_at(p, phi, oobleck::rheology::Control::shear_rate, rate);
+      csv += fmt::format("{},{},{}\n", phi, rate, s.at(0).shear_stress * (1.0 + 0.02 * std::sin(3.0 * k)));
+    }
+  }
+  return csv;
+}
+
+TEST(RheologyCli, FlowCurvePlotWithoutOut) {
+  if (!fs::exists("/usr/bin/python3")) GTEST_SKIP() << "no /usr/bin/python3 for the plot";
+  clitest::TempDir d;
+  auto r = run("rheology flow-curve --preset hermes2016 --phi 0.45 --phi 0.5 --plot " + d / "fc.png");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_GT(fs::file_size(d / "fc.png"), 1000u);
+  EXPECT_EQ(r.output, "wrote " + d / "fc.png" + "\n");
+  for (const auto& e : fs::directory_iterator(d.path)) EXPECT_EQ(e.path().filename(), "fc.png");
+  // Neither --out nor --plot: a usage error (exit 1) that says what to give.
+  r = run("rheology flow-curve --preset hermes2016 --phi 0.45");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("oobleck: error: --out/--plot: give --out CSV, --plot PNG or both"), std::string::npos)
+      << r.output;
+}
+
+TEST(RheologyCli, FlowCurveDrawsMeasuredDataOverTheModel) {
+  if (!fs::exists("/usr/bin/python3")) GTEST_SKIP() << "no /usr/bin/python3 for the plot";
+  clitest::TempDir d;
+  const std::string points = hermes_points();
+  std::ofstream(d / "data.csv") << points;
+  // The plotting script's interpreter is a wrapper that keeps a copy of the data CSV it is given.
+  std::ofstream(d / "python") << "#!/bin/sh\nprev=\nfor a in \"$@\"; do\n  [ \"$prev\" = --data ] && cp \"$a\" '"
+                              << d / "seen.csv"
+                              << "'\n  prev=$a\ndone\nprintf '%s\\n' \"$@\" > '" << d / "args.txt"
+                              << "'\nexec /usr/bin/python3 \"$@\"\n";
+  fs::permissions(d / "python", fs::perms::owner_all);
+  const std::string env = "OOBLECK_PYTHON=" + d / "python" + " ";
+  for (const std::string axes : {"", " --y viscosity", " --x stress --y viscosity --xlim 1e-4,10 --ylim 0.01,10"}) {
+    SCOPED_TRACE(axes);
+    fs::remove(d / "fc.png");
+    const auto r = clitest::shell(env + OOBLECK_CLI + " rheology flow-curve --preset hermes2016 --data " +
+                                  d / "data.csv" + " --plot " + d / "fc.png" + axes);
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("data: " + d / "data.csv" + ": 12 points at phi = 0.4, 0.47\n"), std::string::npos)
+        << r.output;
+    EXPECT_GT(fs::file_size(d / "fc.png"), 1000u);
+    // The script read the data rows: the same phi, rates and stresses (17 significant digits).
+    std::ifstream seen(d / "seen.csv"), given(d / "data.csv");
+    std::string a, b;
+    std::getline(seen, a);  // its own units line
+    EXPECT_EQ(a.rfind("# units: phi=1, shear_rate=1/s, shear_stress=Pa", 0), 0u) << a;
+    std::getline(given, b);
+    for (std::getline(seen, a), std::getline(given, b); std::getline(seen, a) && std::getline(given, b);) {
+      double x[3], y[3];
+      ASSERT_EQ(std::sscanf(a.c_str(), "%lf,%lf,%lf", &x[0], &x[1], &x[2]), 3) << a;
+      ASSERT_EQ(std::sscanf(b.c_str(), "%lf,%lf,%lf", &y[0], &y[1], &y[2]), 3) << b;
+      for (int k = 0; k < 3; ++k) EXPECT_EQ(x[k], y[k]) << a << " vs " << b;
+    }
+    EXPECT_FALSE(std::getline(given, b)) << "not every data row reached the plot";
+    const std::string args = read_text(d / "args.txt");
+    EXPECT_NE(args.find(axes.find("stress") != std::string::npos ? "--x\nstress\n" : "--x\nrate\n"), std::string::npos)
+        << args;
+    if (axes.find("xlim") != std::string::npos) {
+      EXPECT_NE(args.find("--xlim\n0.0001,10\n"), std::string::npos) << args;
+    }
+  }
+  for (const auto& e : fs::directory_iterator(d.path)) {  // no temporaries: the model CSV lived in /tmp
+    EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << e.path();
+  }
+}
+
+TEST(RheologyCli, FlowCurveDrawsAnInstrumentExport) {
+  if (!fs::exists("/usr/bin/python3")) GTEST_SKIP() << "no /usr/bin/python3 for the plot";
+  clitest::TempDir d;
+  const std::string fixture = std::string(OOBLECK_SOURCE_DIR) + "/tests/rheology/data/rheometer/trios_phi040.txt";
+  const auto r =
+      run("rheology flow-curve --preset hermes2016 --data " + fixture +
+          " --step 'Flow sweep' --phi 0.40 --x stress --y viscosity --out " + d / "fc.csv" + " --plot " + d / "fc.png");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("(trios): phi = 0.4, 16 points from step 'Flow sweep - 2'"), std::string::npos) << r.output;
+  EXPECT_GT(fs::file_size(d / "fc.png"), 1000u);
+  EXPECT_NE(read_text(d / "fc.csv").find("\n0.40000000000000002,"),
+            std::string::npos);  // the model at the export's phi
+}
+
+TEST(RheologyCli, FlowCurvePlotOptionsAreCheckedBeforeAnyOutput) {
+  clitest::TempDir d;
+  std::ofstream(d / "data.csv") << hermes_points();
+  const std::string base = "rheology flow-curve --preset hermes2016 --phi 0.45 --out " + d / "fc.csv";
+  const std::pair<std::string, std::string> cases[] = {
+      {base + " --plot " + d / "fc.png" + " --xlim 5,1", "--xlim: '5,1': must be LO,HI with 0 < LO < HI"},
+      {base + " --plot " + d / "fc.png" + " --ylim abc", "--ylim: 'abc': must be LO,HI"},
+      {base + " --plot " + d / "fc.png" + " --xlim 0,1", "--xlim: '0,1'"},
+      {base + " --plot " + d / "fc.png" + " --x stress", "--x stress with --y stress"},
+      {base + " --plot " + d / "fc.png" + " --y strain", "--y"},
+      {base + " --xlim 1,2", "--xlim: draws on the plot: give --plot PNG"},
+      {"rheology flow-curve --preset hermes2016 --data " + d / "data.csv" + " --out " + d / "fc.csv",
+       "--data: draws on the plot"},
+  };
+  for (const auto& [args, message] : cases) {
+    const auto r = run(args);
+    EXPECT_EQ(r.status, 1) << args << "\n" << r.output;
+    EXPECT_NE(r.output.find(message), std::string::npos) << args << "\n" << r.output;
+    EXPECT_FALSE(fs::exists(d / "fc.csv")) << args;
+    EXPECT_FALSE(fs::exists(d / "fc.png")) << args;
+  }
+  // Data at or above the preset's phi_j: an input error naming it (exit 2).
+  std::ofstream(d / "dense.csv") << "phi,shear_rate,shear_stress\n0.6,1,1\n0.6,2,3\n";
+  const auto r = run("rheology flow-curve --preset hermes2016 --data " + d / "dense.csv" + " --plot " + d / "fc.png");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("phi_j = 0.535"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(d / "fc.png"));
 }
 
 struct BadCase {
