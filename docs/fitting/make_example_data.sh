@@ -6,11 +6,12 @@ mkdir -p out/fit
 # 1. flow curves of the dhaene1993 set at 11 volume fractions (our "rheometer")
 $B rheology flow-curve --preset dhaene1993 --points 50 --out out/fit/flow_curves.csv \
   $(for p in 0.30 0.40 0.45 0.50 0.52 0.54 0.55 0.56 0.58 0.60 0.62; do echo --phi $p; done)
-# 2. minimum / plateau viscosity per phi (column 7 = viscosity [Pa s]), with +-2 % scatter
-awk -F, 'BEGIN{srand(7)} NR>1{if(!($1 in m)||$7<m[$1])m[$1]=$7}
+# 2. minimum / plateau viscosity per phi (column 7 = viscosity [Pa s]; data rows only, not the
+#    "# units:" and header lines), with +-2 % scatter
+awk -F, 'BEGIN{srand(7)} /^[0-9]/{if(!($1 in m)||$7<m[$1])m[$1]=$7}
   END{print "phi,viscosity"; for(p in m) printf "%.3f,%.5g\n",p,m[p]*(1+0.04*(rand()-0.5))}' \
   out/fit/flow_curves.csv | sort -n > docs/fitting/min_viscosity.csv
-awk -F, 'BEGIN{srand(8)} NR>1 && $1<0.565 {if(!($1 in m)||$7>m[$1])m[$1]=$7}
+awk -F, 'BEGIN{srand(8)} /^[0-9]/ && $1<0.565 {if(!($1 in m)||$7>m[$1])m[$1]=$7}
   END{print "phi,viscosity"; for(p in m) printf "%.3f,%.5g\n",p,m[p]*(1+0.04*(rand()-0.5))}' \
   out/fit/flow_curves.csv | sort -n > docs/fitting/plateau_viscosity.csv
 # 3. DST onset rates (E14) between phi_c and phi_j, with +-2 % scatter
