@@ -440,6 +440,9 @@ void fit_curves_command(const CurvesOpts& o, const io::CsvTable& t, rheology::Pr
                         {"out", o.out},
                         {"residual", rheology::to_string(options.residual)},
                         {"correlation", r.correlation}};
+    nlohmann::json order = nlohmann::json::array();  // "parameters" is an object: its keys come sorted
+    for (const auto& p : r.parameters) order.push_back(p.name);
+    j["correlation_order"] = order;
     nlohmann::json held = nlohmann::json::array();
     for (const auto& p : r.held) held.push_back({{"name", p.name}, {"value", p.value}, {"reason", p.reason}});
     j["held"] = held;

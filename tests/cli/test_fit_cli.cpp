@@ -270,6 +270,9 @@ TEST_F(FitCli, CurvesFitHoldsWhatTheDataDoNotDetermineWithAWarning) {
   EXPECT_EQ(j["held"][0]["value"].get<double>(), p.eta_B_terms.at(1).phi_i);
   EXPECT_NE(j["held"][0]["reason"].get<std::string>().find("1 sigma: a factor"), std::string::npos);
   EXPECT_EQ(j["parameters"].size() + j["held"].size(), 9u);
+  // the correlation matrix's rows and columns are in the fit's order, which "correlation_order" gives
+  EXPECT_EQ(j["correlation_order"][0], "a_0");
+  EXPECT_EQ(j["correlation"].size(), j["parameters"].size() * j["parameters"].size());
   for (const auto& h : j["held"]) EXPECT_EQ(h["name"].get<std::string>().rfind("eta_B[", 0), 0u) << h;
   const std::pair<const char*, double> truth[] = {
       {"a_0", p.a_0}, {"phi_j", p.phi_j}, {"phi_c", p.phi_c}, {"tau_star", p.tau_star}};
