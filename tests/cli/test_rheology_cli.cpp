@@ -123,15 +123,16 @@ TEST(RheologyCli, FlowCurveDrawsMeasuredDataOverTheModel) {
                               << "'\n  prev=$a\ndone\nprintf '%s\\n' \"$@\" > '" << d / "args.txt"
                               << "'\nexec /usr/bin/python3 \"$@\"\n";
   fs::permissions(d / "python", fs::perms::owner_all);
-  const std::string env = "OOBLECK_PYTHON=" + d / "python" + " ";
+  const std::string command = "OOBLECK_PYTHON=" + d / "python" + " " + OOBLECK_CLI +
+                              " rheology flow-curve --preset hermes2016 --data " + d / "data.csv" + " --plot " +
+                              d / "fc.png";
+  const std::string said = "data: " + d / "data.csv" + ": 12 points at phi = 0.4, 0.47\n";
   for (const std::string axes : {"", " --y viscosity", " --x stress --y viscosity --xlim 1e-4,10 --ylim 0.01,10"}) {
     SCOPED_TRACE(axes);
     fs::remove(d / "fc.png");
-    const auto r = clitest::shell(env + OOBLECK_CLI + " rheology flow-curve --preset hermes2016 --data " +
-                                  d / "data.csv" + " --plot " + d / "fc.png" + axes);
+    const auto r = clitest::shell(command + axes);
     ASSERT_EQ(r.status, 0) << r.output;
-    EXPECT_NE(r.output.find("data: " + d / "data.csv" + ": 12 points at phi = 0.4, 0.47\n"), std::string::npos)
-        << r.output;
+    EXPECT_NE(r.output.find(said), std::string::npos) << r.output;
     EXPECT_GT(fs::file_size(d / "fc.png"), 1000u);
     // The script read the data rows: the same phi, rates and stresses (17 significant digits).
     std::ifstream seen(d / "seen.csv"), given(d / "data.csv");
