@@ -589,10 +589,17 @@ void Sweep::write_csv() const {
   std::set<std::string> reserved = {"run", "status", "message"};
   for (const auto& v : varies_) reserved.insert(v.key);
   std::vector<std::map<std::size_t, std::string>> cells(runs_.size());
+  std::map<std::string, std::string> unit_of;  // column -> unit, from the summaries' "units"
   for (std::size_t i = 0; i < runs_.size(); ++i) {
     if (runs_[i].status != Status::Ok) continue;
-    const auto summary = complete_summary(runs_[i].dir);
+    auto summary = complete_summary(runs_[i].dir);
     if (!summary) continue;
+    if (const auto u = summary->find("units"); u != summary->end()) {
+      if (u->is_object())
+        for (const auto& [key, unit] : u->items())
+          if (unit.is_string()) unit_of[reserved.count(key) != 0 ? "summary." + key : key] = unit.get<std::string>();
+      summary->erase(u);  // (the units are the first line's, not columns)
+    }
     std::vector<std::pair<std::string, std::string>> flat;
     flatten(*summary, "", flat);
     for (auto& [key, value] : flat) {
@@ -602,11 +609,15 @@ void Sweep::write_csv() const {
       cells[i][it->second] = value;
     }
   }
-  // "# units: KEY=UNIT, ..." for the varied keys whose unit the scene file's comments give.
+  // "# units: KEY=UNIT, ..." for the varied keys whose unit the scene file's comments give, then
+  // the summaries' columns whose unit their "units" give.
   const scene::SceneKeyList keys = scene::list_scene_keys(o_.scene);
   std::vector<std::string> units;
   for (const auto& v : varies_)
     if (const std::string u = scene_key_unit(keys, v.key); !u.empty()) units.push_back(fmt::format("{}={}", v.key, u));
+  for (const auto& c : columns)
+    if (const auto u = unit_of.find(c); u != unit_of.end() && u->second.find_first_of(",=\n") == std::string::npos)
+      units.push_back(fmt::format("{}={}", c, u->second));
   io::OutputFile f(o_.out + "/sweep.csv", "--out");
   auto& out = f.stream();
   out << "# units:" << (units.empty() ? "" : " ") << fmt::format("{}", fmt::join(units, ", ")) << "\n";

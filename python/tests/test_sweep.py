@@ -32,9 +32,13 @@ def test_sweep_grid_as_dataframe(root, tmp_path, exe):
     assert df["d"].tolist() == [1e-4, 2e-4, 1e-4, 2e-4]
     assert df["run"].tolist() == ["phi=0.2_d=0.0001", "phi=0.2_d=0.0002", "phi=0.3_d=0.0001", "phi=0.3_d=0.0002"]
     assert (df["status"] == "ok").all()
-    # sweep.csv's units line: d is material.granular.d, "# [m]" in settling.toml (phi has no unit comment)
-    assert (out / "sweep.csv").read_text().startswith("# units: d=m\n")
-    assert df.attrs["units"] == {"d": "m"}
+    # sweep.csv's units line: d is material.granular.d, "# [m]" in settling.toml (phi has no unit
+    # comment), then the summaries' numbers with the units their "units" give
+    assert (out / "sweep.csv").read_text().startswith("# units: d=m, ")
+    units = df.attrs["units"]
+    assert units["d"] == "m" and "phi" not in units and "run" not in units
+    assert units["dt"] == "s" and units["parameters.d"] == "m" and units["settling_velocity"] == "m/s"
+    assert not any(c.startswith("units.") for c in cols)
     for _, row in df.iterrows():
         s = json.loads((out / row["run"] / "summary.json").read_text())
         assert row["settling_velocity"] == s["settling_velocity"]  # round trip exact

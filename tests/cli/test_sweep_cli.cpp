@@ -123,8 +123,13 @@ TEST(SweepCli, GridOfRunsTabulatesEverySummaryScalarAndARerunSkipsCompleteRuns) 
   }
 
   const auto check_table = [&](const std::string& message) {
-    // The units line: d is material.granular.d, "# [m]" in settling.toml (phi has no unit comment).
-    EXPECT_TRUE(read_text(out + "/sweep.csv").starts_with("# units: d=m\nphi,d,run,"));
+    // The units line: d is material.granular.d, "# [m]" in settling.toml (phi has no unit comment),
+    // then the summaries' columns with the units of their "units".
+    const std::string text = read_text(out + "/sweep.csv");
+    EXPECT_TRUE(text.starts_with("# units: d=m, ")) << text.substr(0, 200);
+    const std::string units = text.substr(0, text.find('\n'));
+    for (const char* u : {" dt=s,", " settling_velocity=m/s,", " parameters.d=m,", " parameters.rho_s=kg/m^3,"})
+      EXPECT_NE(units.find(u), std::string::npos) << u << " in " << units;
     const auto rows = read_csv(out + "/sweep.csv");
     ASSERT_EQ(rows.size(), 5u);
     const auto& h = rows[0];
@@ -145,7 +150,9 @@ TEST(SweepCli, GridOfRunsTabulatesEverySummaryScalarAndARerunSkipsCompleteRuns) 
       EXPECT_EQ(row[h.size() - 2], "ok");
       EXPECT_EQ(row.back(), message);
       std::map<std::string, nlohmann::json> flat;
-      flatten(nlohmann::json::parse(read_text(out + "/" + row[2] + "/summary.json")), "", flat);
+      auto summary = nlohmann::json::parse(read_text(out + "/" + row[2] + "/summary.json"));
+      summary.erase("units");  // (its units: the first line's)
+      flatten(summary, "", flat);
       for (const auto& [key, value] : flat) expect_cell(row[column(h, key)], value, row[2] + ": " + key);
       EXPECT_EQ(h.size(), flat.size() + 5) << "one column per scalar of the summaries";
       // What the runs were given: the varied values.

@@ -55,6 +55,10 @@ class CouetteAnalysis final : public SceneAnalysis<G> {
     a["torque_analytic"] = std::fabs(4.0 * M_PI * eta * B * H);
     // Velocity profile error against A r + B/r at the points (L2 relative to U).
     a["velocity_profile_rms_error"] = std::sqrt(e2 / np) / std::fabs(U);
+    a["units"] = {{"torque_inner", "N m"},  // (the whole cylinder's)
+                  {"torque_outer", "N m"},
+                  {"torque_analytic", "N m"},
+                  {"velocity_profile_rms_error", "1"}};
     return a;
   }
 };

@@ -4,6 +4,7 @@
 // (longitudinal) and beside (transverse) the intruder with their fitted speeds,
 // k_l = v_fl/v_0 - 1 and k_t = v_ft/v_0.
 #include <cmath>
+#include <utility>
 
 #include "oobleck/analysis/fronts.hpp"
 #include "oobleck/analysis/summary_json.hpp"
@@ -133,16 +134,28 @@ nlohmann::json IntrusionAnalysis<G>::result() const {
   nlohmann::json vel = fronts(uz_frames_, analysis::velocity_front(v0, cfg_.analysis.front_fraction));
   out["velocity_front"] = vel;
   if (!f_frames_.empty()) out["f_front"] = fronts(f_frames_, analysis::scalar_front(cfg_.analysis.f_threshold));
+  nlohmann::json units;  // (of the top-level numbers: summary.json's "units", run/runner.cpp)
   const nlohmann::json& sp = vel["speeds"];
-  for (const char* k : {"v_fl", "v_ft", "k_l", "k_t", "k_l_over_k_t"})
+  const std::pair<const char*, const char*> speeds[] = {
+      {"v_fl", "m/s"}, {"v_ft", "m/s"}, {"k_l", "1"}, {"k_t", "1"}, {"k_l_over_k_t", "1"}};
+  for (const auto& [k, unit] : speeds) {
     out[k] = sp.is_null() ? nlohmann::json(nullptr) : sp[k];
+    units[k] = unit;
+  }
   const nlohmann::json& spf = vel["speeds_to_farthest"];
-  for (const char* k : {"k_l", "k_t", "k_l_over_k_t"})
+  for (const char* k : {"k_l", "k_t", "k_l_over_k_t"}) {
     out[std::string(k) + "_to_farthest"] = spf.is_null() ? nlohmann::json(nullptr) : spf[k];
+    units[std::string(k) + "_to_farthest"] = "1";
+  }
   out["v0"] = std::fabs(v0);
+  units["v0"] = "m/s";
   out["ramp_time"] = tb.cfg->ramp_time_s;
+  units["ramp_time"] = "s";
   out["filter_window_frames"] = window;
+  units["filter_window_frames"] = "1";
   out["sample_interval"] = sample_dt;
+  units["sample_interval"] = "s";
+  out["units"] = units;
   return out;
 }
 

@@ -77,6 +77,7 @@ class SettlingAnalysis final : public SceneAnalysis<G> {
     a["settling_velocity"] = samples > 0 ? sum / static_cast<double>(samples) : NAN;
     a["settling_velocity_analytic"] = (1.0 - phi) * w;
     a["settling_samples"] = samples;
+    a["units"] = {{"settling_velocity", "m/s"}, {"settling_velocity_analytic", "m/s"}, {"settling_samples", "1"}};
     return a;
   }
 };

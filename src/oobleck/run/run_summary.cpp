@@ -8,55 +8,60 @@
 
 namespace oobleck::run {
 
-nlohmann::json parameters(const scene::SceneConfig& config) {
+nlohmann::json parameters(const scene::SceneConfig& config, nlohmann::json& units) {
   const int D = config.grid.dim;
   const auto& s = config.material.steady;
   const auto& g = config.material.granular;
   nlohmann::json p;
+  const auto put = [&](const char* key, nlohmann::json value, const char* unit) {
+    p[key] = std::move(value);
+    units[std::string("parameters.") + key] = unit;
+  };
   p["preset"] = config.material.name;
-  p["phi"] = config.regions.front().phi;
-  p["rho_s"] = g.rho_s;
-  p["rho_f"] = config.fluid.rho_f0_kg_m3;
-  p["eta_0"] = config.fluid.eta_0_Pa_s;
-  p["kappa"] = config.fluid.kappa_Pa;
-  p["d"] = g.d;
-  p["G"] = g.G;
-  p["K"] = g.K;
-  p["K_0"] = g.K_0;
-  p["K_3"] = g.K_3;
-  p["K_4"] = g.K_4;
-  p["mu_1"] = s.mu_c;
-  p["mu_2"] = g.mu_2 < 0 ? s.mu_c : g.mu_2;
-  p["b"] = g.b;
-  p["phi_c"] = s.phi_c;
-  p["phi_j"] = s.phi_j;
-  p["a_0"] = s.a_0;
-  p["a_inf"] = s.a_inf;
-  p["tau_star"] = s.tau_star;
-  p["Delta"] = s.Delta;
-  p["xi_dot_eps"] = s.xi_dot_eps;
+  put("phi", config.regions.front().phi, "1");
+  put("rho_s", g.rho_s, "kg/m^3");
+  put("rho_f", config.fluid.rho_f0_kg_m3, "kg/m^3");
+  put("eta_0", config.fluid.eta_0_Pa_s, "Pa s");
+  put("kappa", config.fluid.kappa_Pa, "Pa");
+  put("d", g.d, "m");
+  put("G", g.G, "Pa");
+  put("K", g.K, "Pa");
+  put("K_0", g.K_0, "1");
+  put("K_3", g.K_3, "1");
+  put("K_4", g.K_4, "1");
+  put("mu_1", s.mu_c, "1");
+  put("mu_2", g.mu_2 < 0 ? s.mu_c : g.mu_2, "1");
+  put("b", g.b, "1");
+  put("phi_c", s.phi_c, "1");
+  put("phi_j", s.phi_j, "1");
+  put("a_0", s.a_0, "1");
+  put("a_inf", s.a_inf, "1");
+  put("tau_star", s.tau_star, "Pa");
+  put("Delta", s.Delta, "1");
+  put("xi_dot_eps", s.xi_dot_eps, "1/s");
   nlohmann::json terms = nlohmann::json::array();
   for (const auto& t : s.eta_B_terms) terms.push_back({{"phi_i", t.phi_i}, {"alpha", t.alpha}});
   p["eta_B"] = terms;
   p["gravity"] = std::vector<double>(config.gravity_m_s2.begin(), config.gravity_m_s2.begin() + D);
-  p["porosity_min"] = config.coupling.porosity_min;
+  put("porosity_min", config.coupling.porosity_min, "1");
   p["drag"] = config.coupling.drag == scene::DragLaw::Beetstra ? "beetstra" : "carman_kozeny";
-  p["cell_size"] = config.grid.cell_size_m;
+  put("cell_size", config.grid.cell_size_m, "m");
   p["cells"] = std::vector<int>(config.grid.cells.begin(), config.grid.cells.begin() + D);
   p["shape_function"] = scene::to_string(config.grid.shape);
   p["transfer"] = config.transfer.scheme == scene::TransferScheme::Apic ? "apic" : "flip";
-  if (config.transfer.scheme == scene::TransferScheme::Flip) p["flip_fraction"] = config.transfer.flip_fraction;
+  if (config.transfer.scheme == scene::TransferScheme::Flip) put("flip_fraction", config.transfer.flip_fraction, "1");
   if (config.grid.geometry == scene::Geometry::Axisymmetric) {
-    p["r_inner"] = config.grid.origin_m[0];
-    p["r_outer"] = config.grid.origin_m[0] + config.grid.size_m[0];
-    p["height"] = config.grid.size_m[1];
-    if (config.boundary[0].type == scene::BoundaryType::Velocity) p["u_inner"] = config.boundary[0].velocity_m_s[2];
+    put("r_inner", config.grid.origin_m[0], "m");
+    put("r_outer", config.grid.origin_m[0] + config.grid.size_m[0], "m");
+    put("height", config.grid.size_m[1], "m");
+    if (config.boundary[0].type == scene::BoundaryType::Velocity)
+      put("u_inner", config.boundary[0].velocity_m_s[2], "m/s");
   }
   return p;
 }
 
 template <class G>
-nlohmann::json bodies_summary(const scene::BuiltScene<G>& scene) {
+nlohmann::json bodies_summary(const scene::BuiltScene<G>& scene, nlohmann::json& units) {
   constexpr int D = G::dim, NC = G::ncomp;
   auto& solver = *scene.solver;
   nlohmann::json bodies = nlohmann::json::object();
@@ -72,13 +77,19 @@ nlohmann::json bodies_summary(const scene::BuiltScene<G>& scene) {
                             {"centre", std::vector<double>(c.data(), c.data() + D)},
                             {"velocity", std::vector<double>(v.data(), v.data() + NC)},
                             {"contact_force_last_step", std::vector<double>(F.data(), F.data() + NC)}};
-    if (tb.cfg->motion == scene::BodyMotionKind::Prescribed) bodies[tb.cfg->name]["ramp_time"] = tb.cfg->ramp_time_s;
+    const std::string at = "bodies." + tb.cfg->name + ".";
+    units[at + "points"] = "1";
+    units[at + "mass"] = std::is_same_v<G, mpm::PlaneStrain> ? "kg/m" : "kg";  // (axisymmetric: the whole body)
+    if (tb.cfg->motion == scene::BodyMotionKind::Prescribed) {
+      bodies[tb.cfg->name]["ramp_time"] = tb.cfg->ramp_time_s;
+      units[at + "ramp_time"] = "s";
+    }
   }
   return bodies;
 }
 
-template nlohmann::json bodies_summary(const scene::BuiltScene<mpm::PlaneStrain>&);
-template nlohmann::json bodies_summary(const scene::BuiltScene<mpm::Axisymmetric>&);
-template nlohmann::json bodies_summary(const scene::BuiltScene<mpm::ThreeD>&);
+template nlohmann::json bodies_summary(const scene::BuiltScene<mpm::PlaneStrain>&, nlohmann::json&);
+template nlohmann::json bodies_summary(const scene::BuiltScene<mpm::Axisymmetric>&, nlohmann::json&);
+template nlohmann::json bodies_summary(const scene::BuiltScene<mpm::ThreeD>&, nlohmann::json&);
 
 }  // namespace oobleck::run
