@@ -45,7 +45,7 @@ struct CurvesFitOptions {
   /// 0 <= Delta <= 1, 0 <= alpha <= 60, phi_i > 0).
   std::vector<ParameterBounds> bounds;
   std::string where = "data";  ///< names the data source in messages
-  int max_iterations = 200;
+  int max_iterations = 1000;
   /// false: a parameter the data do not determine is held at the base set's value (see
   /// CurvesFitResult::held); true: it is an InputError naming it.
   bool strict = false;
