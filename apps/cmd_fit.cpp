@@ -416,7 +416,9 @@ void fit_curves_command(const CurvesOpts& o, const io::CsvTable& t, rheology::Pr
   std::string tmp_png;
   if (!o.png.empty()) {
     tmp_png = plot_curves_fit(r, t, options.residual,
-                              fmt::format("{}: fit --kind curves (base {})", o.names(), preset.name), o.png);
+                              fmt::format("{}: fit --kind curves (base {}){}", o.names(), preset.name,
+                                          r.held.empty() ? "" : "\nheld at the base values: " + held_names(r)),
+                              o.png);
   }
   try {
     io::write_file_atomically(o.out, h + rheology::to_toml(fitted), "--out");
