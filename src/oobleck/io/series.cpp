@@ -56,7 +56,7 @@ std::string units_line(const std::vector<std::string>& columns, const std::vecto
 SeriesWriter::SeriesWriter(std::string path, std::vector<std::string> columns, std::FILE* f)
     : path_(std::move(path)), columns_(std::move(columns)), file_(f) {}
 
-SeriesWriter::SeriesWriter(std::string path, std::vector<std::string> columns, std::vector<std::string> units)
+SeriesWriter::SeriesWriter(std::string path, std::vector<std::string> columns, const std::vector<std::string>& units)
     : path_(std::move(path)), columns_(std::move(columns)) {
   const std::string header = units_line(columns_, units) + header_line(columns_);
   check_writable(path_, "series");
@@ -68,7 +68,7 @@ SeriesWriter::SeriesWriter(std::string path, std::vector<std::string> columns, s
 }
 
 SeriesWriter SeriesWriter::resume(std::string path, std::vector<std::string> columns, double keep_until,
-                                  std::vector<std::string> units) {
+                                  const std::vector<std::string>& units) {
   const std::string header = header_line(columns);
   const std::string units_text = units_line(columns, units);
   std::ifstream in(path, std::ios::binary);

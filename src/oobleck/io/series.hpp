@@ -20,14 +20,14 @@ class SeriesWriter {
   /// column) and the header. Column names: non-empty, no ',', '"' or line breaks, unique; units:
   /// non-empty, no ',', '=' or line breaks (std::invalid_argument). InputError when the folder is
   /// missing or read-only.
-  SeriesWriter(std::string path, std::vector<std::string> columns, std::vector<std::string> units = {});
+  SeriesWriter(std::string path, std::vector<std::string> columns, const std::vector<std::string>& units = {});
 
   /// Continue the series of a restarted run: `path` must exist with exactly these columns
   /// (InputError naming the file otherwise; its '#' lines are not compared); rows whose first
   /// column is > `keep_until` (the restart step or time) are dropped, the units line is written
   /// anew, atomically, and new rows are appended.
   static SeriesWriter resume(std::string path, std::vector<std::string> columns, double keep_until,
-                             std::vector<std::string> units = {});
+                             const std::vector<std::string>& units = {});
 
   SeriesWriter(SeriesWriter&& o) noexcept;
   SeriesWriter& operator=(SeriesWriter&& o) noexcept;
