@@ -12,8 +12,9 @@
 namespace oobleck::cli {
 
 void ParamsOption::add_to(CLI::App* cmd) {
-  auto* a = cmd->add_option("--preset", preset,
-                            fmt::format("parameter set shipped in presets/: {}", fmt::join(rheology::preset_names(), ", ")));
+  auto* a =
+      cmd->add_option("--preset", preset,
+                      fmt::format("parameter set shipped in presets/: {}", fmt::join(rheology::preset_names(), ", ")));
   auto* b = cmd->add_option("--params", params, "parameter file (TOML, same format as presets/*.toml)");
   a->excludes(b);
   b->excludes(a);

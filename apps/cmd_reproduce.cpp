@@ -26,7 +26,8 @@ std::string self_exe() {
   std::error_code ec;
   std::string p = fs::read_symlink("/proc/self/exe", ec).string();
   // Rebuilt while reproduce runs: Linux appends " (deleted)"; the path holds the new build.
-  if (const std::string gone = " (deleted)"; p.size() > gone.size() && p.ends_with(gone)) p.resize(p.size() - gone.size());
+  if (const std::string gone = " (deleted)"; p.size() > gone.size() && p.ends_with(gone))
+    p.resize(p.size() - gone.size());
   return ec ? std::string("oobleck") : p;
 }
 
@@ -352,20 +353,28 @@ void rod(Reproduction& r) {
               fmt::format("S2 rod impact, large container, v0 = {} m/s (Fig. 8)", v0));
     runs.push_back(r.out + "/" + name);
     const auto s = r.summary(name);
-    const double peak = s["peak_deceleration_from_force"]["peak_deceleration"].get<double>();
+    // The sustained deceleration, from the filtered position (2 ms stencil): the contact force's
+    // own peak is the first step's impact impulse on every Fig. 8 run, at the first sample and
+    // falling with the cell size (docs/results.md, S2 diagnosis); it is reported, not judged.
+    const double peak =
+        s.contains("peak_deceleration") ? s["peak_deceleration"]["peak_deceleration"].get<double>() : 0.0;
     outcomes.push_back(
         {fmt::format("v0 {}", v0), peak > 10 * 9.81 && std::fabs(s["final_velocity"].get<double>()) < 0.5 * v0});
-    measured += fmt::format("v0 {}: peak {:.0f} m/s² at {:.2g} ms, final v {:.2f} m/s; ", v0,
-                            s["peak_deceleration_from_force"]["peak_deceleration"].get<double>(),
-                            1e3 * s["peak_deceleration_from_force"]["peak_deceleration_time"].get<double>(),
-                            s["final_velocity"].get<double>());
+    measured += fmt::format(
+        "v0 {}: deceleration {:.0f} m/s² at {:.2g} ms (contact-force spike {:.0f} m/s² at {:.2g} ms), final v {:.2f} "
+        "m/s; ",
+        v0, peak,
+        s.contains("peak_deceleration") ? 1e3 * s["peak_deceleration"]["peak_deceleration_time"].get<double>() : 0.0,
+        s["peak_deceleration_from_force"]["peak_deceleration"].get<double>(),
+        1e3 * s["peak_deceleration_from_force"]["peak_deceleration_time"].get<double>(),
+        s["final_velocity"].get<double>());
   }
   std::vector<std::string> args = {"--dynamics", r.out + "/rod_fig8.png"};
   args.insert(args.end(), runs.begin(), runs.end());
   run_tool("plot_rod.py", args);
   r.figures.push_back(r.out + "/rod_fig8.png");
   r.claims.push_back({"S2 rod dynamics (large container)", "stiff deceleration at impact, then slow sinking", measured,
-                      subset_verdict(outcomes, "with a peak > 10 g and a final speed < v0/2")});
+                      subset_verdict(outcomes, "with a sustained deceleration > 10 g and a final speed < v0/2")});
 }
 
 void wheel(Reproduction& r) {

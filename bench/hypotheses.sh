@@ -6,7 +6,7 @@
 #   bash bench/hypotheses.sh CLAIM [BUILD=build/release] [OUT=out/hypotheses_CLAIM] [JOBS=2]
 # CLAIM: s3 (intruder fronts; tools/hypotheses_table.py s3_recession OUT tables how far each front ran and fell back at phi 0.47 / v0 0.2 and phi 0.49 / v0 0.5, 1 mm, 20 ms; ~1-2 min
 # per run on one thread, the deep bed ~3 min, the 0.5 mm grid ~5 min; 40 runs), s1 (fast bob, 1 mm, 0.1 s; ~1 min per run),
-# s2 (rod launched at 0.5, 1, 2 m/s into the large container, 60 ms, 5 / 2.5 / 2 mm; the changes at 2.5 mm),
+# s2 (rod launched at 0.5, 1, 2 m/s into the large container, 60 ms, 5 / 2.5 mm and 1.5 mm at 1 m/s; the changes at 2.5 mm),
 # s4 (fast and slow wheel, 13.3 mm, 1.5 s; 10-20 min per run).
 set -euo pipefail
 exe() { if [ -d "$1" ]; then echo "$1/oobleck"; else echo "$1"; fi; }
@@ -38,10 +38,11 @@ case "$CLAIM" in
       "cells_2mm|$s|grid.cell_size=0.002")
     points=("fast|") ;;
   s2)
-    # Fig. 8 on 5, 2.5 and 2 mm cells (the paper's 1 mm takes 95 min per run, 2 mm ~12 min, 2.5 mm
-    # ~6 min, 5 mm < 1 min); the set-up and model changes on 2.5 mm cells at v0 = 1 m/s
+    # Fig. 8 on 5, 2.5 and 1.5 mm cells (cells divide the 0.15 x 0.225 m grid; the paper's 1 mm takes
+    # 95 min per run, 1.5 mm ~22 min, 2.5 mm 2-5 min, 5 mm < 2 min); the set-up and model changes on
+    # 2.5 mm cells at v0 = 1 m/s
     s=scenes/paper/rod_impact_large.toml
-    variants=("h5mm|$s|cell_size=0.005" "h2.5mm|$s|cell_size=0.0025" "h2mm|$s|cell_size=0.002|v1"
+    variants=("h5mm|$s|cell_size=0.005" "h2.5mm|$s|cell_size=0.0025" "h1.5mm|$s|cell_size=0.0015|v1"
       "h2.5mm_rod_mass_0.1|$s|cell_size=0.0025 rod_mass=0.1|v1" "h2.5mm_rod_mass_1|$s|cell_size=0.0025 rod_mass=1.0|v1"
       "h2.5mm_eta_0_x10|$s|cell_size=0.0025 eta_0=1e-2|v1" "h2.5mm_frictionless|$s|cell_size=0.0025 body.0.friction=0|v1"
       "h2.5mm_flip|$s|cell_size=0.0025 $flip|v1")

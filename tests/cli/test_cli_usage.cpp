@@ -49,7 +49,8 @@ void collect_commands(const std::string& path, std::vector<std::string>& out) {
 TEST(CliUsage, UnknownCommandExitsOneAndSuggestsTheNearest) {
   const auto r = run("rnu scenes/paper/intrusion.toml");
   EXPECT_EQ(r.status, 1) << r.output;
-  EXPECT_TRUE(contains(r.output, "oobleck: error: unknown command 'rnu' for 'oobleck'; did you mean 'run'?")) << r.output;
+  EXPECT_TRUE(contains(r.output, "oobleck: error: unknown command 'rnu' for 'oobleck'; did you mean 'run'?"))
+      << r.output;
   const auto sub = run("rheology flow-curv --phi 0.4");
   EXPECT_EQ(sub.status, 1);
   EXPECT_TRUE(contains(sub.output, "unknown command 'flow-curv' for 'oobleck rheology'; did you mean 'flow-curve'?"))
@@ -63,7 +64,8 @@ TEST(CliUsage, UnknownCommandExitsOneAndSuggestsTheNearest) {
 TEST(CliUsage, UnknownOptionExitsOneAndSuggestsTheNearest) {
   const auto r = run("run --thraeds 2 scenes/paper/intrusion.toml");
   EXPECT_EQ(r.status, 1) << r.output;
-  EXPECT_TRUE(contains(r.output, "unknown option '--thraeds' for 'oobleck run'; did you mean '--threads'?")) << r.output;
+  EXPECT_TRUE(contains(r.output, "unknown option '--thraeds' for 'oobleck run'; did you mean '--threads'?"))
+      << r.output;
   EXPECT_TRUE(contains(r.output, "Run 'oobleck run --help'")) << r.output;
   const auto eq = run("point relax --phi 0.5 --durration=1");
   EXPECT_EQ(eq.status, 1);
@@ -110,7 +112,8 @@ TEST(CliUsage, TheShortExamplesRun) {
     const auto help = run(c + " --help").output;
     std::string example = help.substr(help.rfind("\nExample:\n  oobleck ") + 20);
     example = example.substr(0, example.find('\n'));
-    example = std::regex_replace(example, std::regex(" (docs|scenes|tests)/"), std::string(" ") + OOBLECK_SOURCE_DIR + "/$1/");
+    example = std::regex_replace(example, std::regex(" (docs|scenes|tests)/"),
+                                 std::string(" ") + OOBLECK_SOURCE_DIR + "/$1/");
     const auto r = clitest::shell("cd " + d.path.string() + " && " + std::string(OOBLECK_CLI) + " " + example);
     EXPECT_EQ(r.status, 0) << "oobleck " << example << "\n" << r.output;
     ++ran;
@@ -134,8 +137,10 @@ TEST(CliUsage, ListKeysPrintsAliasesAndKeysWithTheirComments) {
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_TRUE(std::regex_search(r.output, std::regex(R"(\n  phi +0\.47 +region\.0\.phi +\[-\] bed volume fraction\n)")))
       << r.output;
-  EXPECT_TRUE(std::regex_search(r.output, std::regex(R"(\n  depth +\[0\.05, 0\.03\] +region\.0\.max +\n)"))) << r.output;
-  EXPECT_TRUE(std::regex_search(r.output, std::regex(R"(\n  speed +\(default\) +body\.0\.speed +\[m/s\])"))) << r.output;
+  EXPECT_TRUE(std::regex_search(r.output, std::regex(R"(\n  depth +\[0\.05, 0\.03\] +region\.0\.max +\n)")))
+      << r.output;
+  EXPECT_TRUE(std::regex_search(r.output, std::regex(R"(\n  speed +\(default\) +body\.0\.speed +\[m/s\])")))
+      << r.output;
   EXPECT_TRUE(std::regex_search(r.output, std::regex(R"(\n  grid\.cell_size = 0\.002 +# \[m\] coarse\n)"))) << r.output;
   EXPECT_TRUE(contains(r.output, "\n  region.0.phi = 0.47\n")) << r.output;
   EXPECT_TRUE(contains(r.output, "\n  scene.name = \"t\"\n")) << r.output;

@@ -26,7 +26,8 @@ std::vector<std::string> claim_rows(const std::string& md) {
 std::vector<std::string> cells(const std::string& row) {
   std::vector<std::string> out;
   std::size_t at = 1;
-  for (std::size_t next; (next = row.find(" | ", at)) != std::string::npos; at = next + 2) out.push_back(row.substr(at + 1, next - at - 1));
+  for (std::size_t next; (next = row.find(" | ", at)) != std::string::npos; at = next + 2)
+    out.push_back(row.substr(at + 1, next - at - 1));
   out.push_back(row.substr(at + 1, row.size() - at - 3));
   return out;
 }
@@ -42,12 +43,23 @@ TEST(ReproduceCli, QuickReportsEveryClaimWithNumbersAndAVerdict) {
   const auto r = clitest::run("reproduce --quick --threads 1 --out " + d / "rep");
   ASSERT_EQ(r.status, 0) << r.output;
   const auto rows = claim_rows(clitest::read_text(d / "rep/report.md"));
-  const std::vector<std::string> expected = {
-      "V4 settling", "V3 torque", "S1 fast bob: a band grows", "S1 fast bob: the band rotates rigidly",
-      "S1 fast bob: flow stops", "S1 fast bob: jammed structure", "S1 slow bob", "S1: steady 1D Couette",
-      "S3 Fig. 9 run", "S3 k_l/k_t of the u_z = 0.5 v0 front up to its farthest extent", "S3 the same over the whole run",
-      "S2 |dz| vs depth", "S2 rod dynamics", "S4 wheel at omega = 10", "S4 wheel at omega = 1", "S4 fast vs slow",
-      "SI: pressure under the wheel"};
+  const std::vector<std::string> expected = {"V4 settling",
+                                             "V3 torque",
+                                             "S1 fast bob: a band grows",
+                                             "S1 fast bob: the band rotates rigidly",
+                                             "S1 fast bob: flow stops",
+                                             "S1 fast bob: jammed structure",
+                                             "S1 slow bob",
+                                             "S1: steady 1D Couette",
+                                             "S3 Fig. 9 run",
+                                             "S3 k_l/k_t of the u_z = 0.5 v0 front up to its farthest extent",
+                                             "S3 the same over the whole run",
+                                             "S2 |dz| vs depth",
+                                             "S2 rod dynamics",
+                                             "S4 wheel at omega = 10",
+                                             "S4 wheel at omega = 1",
+                                             "S4 fast vs slow",
+                                             "SI: pressure under the wheel"};
   ASSERT_EQ(rows.size(), expected.size()) << clitest::read_text(d / "rep/report.md");
   const std::regex verdict(R"(^(met|not met)\b)"), number(R"(\d\.\d)");
   for (std::size_t i = 0; i < rows.size(); ++i) {

@@ -1026,8 +1026,8 @@ FlowCurveRows flow_curve_rows(const RheometerFile& f, const std::string& step_sp
       std::vector<std::string> names;
       names.reserve(steps.size());
       for (std::size_t k : steps) names.push_back(fmt::format("{} '{}'", f.steps[k].index, f.steps[k].name));
-      throw InputError(fmt::format("{}: {} steps hold shear rate and stress ({}): choose one with {} NAME or INDEX", f.file,
-                                   steps.size(), fmt::join(names, ", "), option));
+      throw InputError(fmt::format("{}: {} steps hold shear rate and stress ({}): choose one with {} NAME or INDEX",
+                                   f.file, steps.size(), fmt::join(names, ", "), option));
     }
   }
   FlowCurveRows out;

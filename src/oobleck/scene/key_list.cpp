@@ -49,7 +49,8 @@ struct Walker {
   void walk(const std::string& prefix, const toml::node& node) {
     if (const auto* t = node.as_table()) {
       if (t->is_inline()) return leaf(prefix, node);
-      for (const auto& [k, v] : *t) walk(prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str()), v);
+      for (const auto& [k, v] : *t)
+        walk(prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str()), v);
     } else if (const auto* a = node.as_array(); a != nullptr && a->is_array_of_tables()) {
       for (std::size_t i = 0; i < a->size(); ++i) walk(fmt::format("{}.{}", prefix, i), *a->get(i));
     } else {
@@ -83,9 +84,9 @@ SceneKeyList list_scene_keys(const std::string& path) {
     for (const auto& [k, v] : *al) {
       const std::string target = v.value<std::string>().value_or("");
       const auto it = values.find(target);
-      aliases.push_back({v.source().begin.line,
-                         {std::string(k.str()), target, it == values.end() ? "" : it->second,
-                          trailing_comment(lines, v.source())}});
+      aliases.push_back(
+          {v.source().begin.line,
+           {std::string(k.str()), target, it == values.end() ? "" : it->second, trailing_comment(lines, v.source())}});
     }
   }
   std::stable_sort(aliases.begin(), aliases.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
