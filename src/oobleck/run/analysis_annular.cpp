@@ -5,6 +5,7 @@
 // flow of the bed.
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "oobleck/analysis/annular.hpp"
 #include "oobleck/analysis/summary_json.hpp"
@@ -129,6 +130,17 @@ nlohmann::json AnnularAnalysis<G>::result() const {
   a.update(fronts_result(geo));
   a["steady_flow"] = steady_flow_result(geo);
   if (!frames_.front().f.values.empty()) a.update(structure_front_result(geo));
+  // The units of the top-level numbers written (summary.json's "units", run/runner.cpp).
+  const std::pair<const char*, const char*> units[] = {{"bob_angle_final_rad", "rad"},
+                                                       {"front_farthest", "m"},
+                                                       {"front_farthest_time", "s"},
+                                                       {"front_speed", "m/s"},
+                                                       {"flow_stop_time", "s"},
+                                                       {"structure_front_threshold", "1"},
+                                                       {"structure_front_wall_time", "s"},
+                                                       {"structure_front_speed", "m/s"}};
+  for (const auto& [key, unit] : units)
+    if (a.contains(key)) a["units"][key] = unit;
   return a;
 }
 

@@ -105,6 +105,12 @@ nlohmann::json RodAnalysis<G>::result() const {
   out["final_depth"] = surface - zb.value.back();
   if (!profile_.is_null()) out["displacement_below_rod"] = profile_;
   out["final_velocity"] = vz.value.back();
+  out["units"] = {{"rod_mass", std::is_same_v<G, mpm::PlaneStrain> ? "kg/m" : "kg"},  // (axisymmetric: whole rod)
+                  {"difference_stencil_samples", "1"},
+                  {"bed_surface", "m"},
+                  {"impact_time", "s"},
+                  {"final_depth", "m"},
+                  {"final_velocity", "m/s"}};
   return out;
 }
 

@@ -148,6 +148,7 @@ nlohmann::json WheelAnalysis<G>::result() const {
   out["omega_measured"] = analysis::to_json(om);
   out["omega"] = omega;
   out["pressure_scatter"] = scatter_result();
+  out["units"] = {{"omega", "rad/s"}};
   return out;
 }
 
