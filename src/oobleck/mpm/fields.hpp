@@ -1,7 +1,7 @@
 #pragma once
 // The registry of persistent fields: every array that a restart needs or that the frames show is
 // declared once, by its owner, as a PersistentField in a FieldList. Checkpoint write and restore
-// (run/solver_state.cpp) and the frames (run/run_output.cpp) iterate that list; none of them
+// (run/checkpoint_state.cpp) and the frames (run/run_output.cpp) iterate that list; none of them
 // names a field.
 //
 // Owners and their declarations:
@@ -9,7 +9,7 @@
 //   StressLaw<G>::declare_fields     a law's per-point state (GranularBodyLaw: group "granular",
 //                                    FluidLaw: "fluid") and what it adds to its body's frames
 //   RigidMotion / ContactPair        a [[body]] entry's rigid velocity and contact impulse sum
-//   (via run/solver_state.cpp)       (group "third<k>")
+//   (via run/checkpoint_state.cpp)   (group "third<k>")
 //   Solver<G>::declare_grid_fields   nodal arrays the frames show on the grid (group "grid")
 //   run::SceneAnalysis::declare_fields, run::Snapshots::declare_fields
 //                                    a scene measurement's samples (group "analysis") and its
