@@ -163,7 +163,8 @@ TEST(Frames, EveryDatasetCarriesItsUnits) {
   PointCloud rod("rod", 2, pos, "mm");  // positions in other units than metres
   rod.scalar("f", p, "1");
   NodeGrid grid(2, {0, 0, 0}, {1, 1, 0}, {3, 2, 1});
-  grid.scalar("porosity", ramp(6, 0.5), "1");
+  const auto porosity = ramp(6, 0.5);  // a field is a view: its values must outlive the write
+  grid.scalar("porosity", porosity, "1");
   FrameWriter writer(dir.str());
   const std::string path = writer.write({0.0, 0, {grains, rod}, grid});
   const std::map<std::string, std::string> expected = {{"/bodies/grains/position", "m"},
