@@ -47,8 +47,10 @@ const std::map<std::string, std::string>& examples() {
 /// "rheology fit" for the command `oobleck rheology fit` ("" for oobleck itself).
 std::string path_of(const CLI::App& cmd) {
   std::string path;
-  for (const CLI::App* a = &cmd; a->get_parent() != nullptr; a = a->get_parent())
-    path = path.empty() ? a->get_name() : a->get_name() + " " + path;
+  for (const CLI::App* a = &cmd; a->get_parent() != nullptr; a = a->get_parent()) {
+    if (!path.empty()) path.insert(0, 1, ' ');
+    path.insert(0, a->get_name());
+  }
   return path;
 }
 
