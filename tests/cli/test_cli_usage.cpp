@@ -41,7 +41,12 @@ std::vector<std::string> subcommands_in_help(const std::string& help) {
 void collect_commands(const std::string& path, std::vector<std::string>& out) {
   out.push_back(path);
   const auto r = run(path + " --help");
-  for (const auto& sub : subcommands_in_help(r.output)) collect_commands(path.empty() ? sub : path + " " + sub, out);
+  for (const auto& sub : subcommands_in_help(r.output)) {
+    std::string below = path;
+    if (!below.empty()) below += ' ';
+    below += sub;
+    collect_commands(below, out);
+  }
 }
 
 }  // namespace
