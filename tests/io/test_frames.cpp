@@ -268,7 +268,8 @@ TEST(Frames, GridPartLandsInItsBox) {
   EXPECT_EQ(inside, static_cast<int>(n));
   NodeGrid other(3, {0, 0, 0}, {0.1, 0.1, 0.1}, {nx, ny, nz});
   EXPECT_THROW(other.set_part({3, 0, 0}, {2, 1, 1}), std::invalid_argument);  // leaves the grid along x
-  other.scalar("id", std::vector<double>(nx * ny * nz, 1.0), "1");
+  const std::vector<double> ids(nx * ny * nz, 1.0);
+  other.scalar("id", ids, "1");
   EXPECT_THROW(other.set_part(begin, extent), std::invalid_argument);  // after a field
 }
 

@@ -101,6 +101,13 @@ class FieldSet {
   /// 9 spans, row-major.
   FieldSet& tensor(std::string name, std::initializer_list<std::span<const double>> components, std::string units);
 
+  // A field is a view of its values, which must outlive the write: a temporary vector would
+  // dangle, so passing one does not compile.
+  FieldSet& scalar(std::string name, std::vector<double>&& values, std::string units) = delete;
+  FieldSet& vector(std::string name, int components, std::vector<double>&& interleaved, std::string units) = delete;
+  FieldSet& sym_tensor(std::string name, std::vector<double>&& interleaved, std::string units) = delete;
+  FieldSet& tensor(std::string name, std::vector<double>&& interleaved, std::string units) = delete;
+
  protected:
   void add(FieldView field);
   std::size_t count_;
