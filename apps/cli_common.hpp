@@ -1,7 +1,9 @@
 #pragma once
 // Pieces shared by the oobleck subcommands: parameter selection (--preset/--params), plotting
 // through matplotlib scripts in tools/, and number formatting for CSV/JSON.
+#include <filesystem>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -33,6 +35,19 @@ void plot(const std::string& script, std::vector<std::string> args, const std::s
 
 /// Shortest round-trip representation of a double ("17 significant digits").
 std::string num(double v);
+
+/// Temporary files of a command (the plot scripts' inputs), removed when it goes out of scope,
+/// whatever the exit path.
+struct TempFiles {
+  std::vector<std::string> files;
+  TempFiles() = default;
+  TempFiles(const TempFiles&) = delete;
+  TempFiles& operator=(const TempFiles&) = delete;
+  ~TempFiles() {
+    std::error_code ec;
+    for (const auto& f : files) std::filesystem::remove(f, ec);
+  }
+};
 
 /// Register subcommands (one file per command group).
 void add_rheology_commands(CLI::App& app);

@@ -135,13 +135,8 @@ std::string plot_fit(const rheology::FitResult& r, const Data& d, const std::str
   const std::string stem = fmt::format("oobleck-fit-{}", ::getpid());
   const std::string data_csv = (dir / (stem + "-data.csv")).string();
   const std::string curve_csv = (dir / (stem + "-curve.csv")).string();
-  struct Cleanup {
-    std::vector<std::string> files;
-    ~Cleanup() {
-      std::error_code ec;
-      for (const auto& f : files) fs::remove(f, ec);
-    }
-  } cleanup{{data_csv, curve_csv}};
+  TempFiles cleanup;
+  cleanup.files = {data_csv, curve_csv};
 
   std::string s = "phi,data,model\n";
   for (std::size_t k = 0; k < d.phi.size(); ++k) {
@@ -301,13 +296,8 @@ std::string plot_curves_fit(const rheology::CurvesFitResult& r, const io::CsvTab
   const std::string stem = fmt::format("oobleck-fit-{}", ::getpid());
   const std::string data_csv = (dir / (stem + "-data.csv")).string();
   const std::string curve_csv = (dir / (stem + "-curve.csv")).string();
-  struct Cleanup {
-    std::vector<std::string> files;
-    ~Cleanup() {
-      std::error_code ec;
-      for (const auto& f : files) fs::remove(f, ec);
-    }
-  } cleanup{{data_csv, curve_csv}};
+  TempFiles cleanup;
+  cleanup.files = {data_csv, curve_csv};
 
   const std::vector<double> phi = t.column("phi"), rate = t.column("shear_rate"), stress = t.column("shear_stress");
   std::string s = "phi,shear_rate,shear_stress,model,residual\n";

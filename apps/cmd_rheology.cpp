@@ -155,13 +155,7 @@ void flow_curve_command(CLI::App& rheology) {
     const std::string stem = fmt::format("oobleck-flow-curve-{}", ::getpid());
     const std::string curves_csv = o->out.empty() ? (tmp_dir / (stem + "-model.csv")).string() : o->out;
     const std::string data_csv = (tmp_dir / (stem + "-data.csv")).string();
-    struct Cleanup {
-      std::vector<std::string> files;
-      ~Cleanup() {
-        std::error_code ec;
-        for (const auto& f : files) fs::remove(f, ec);
-      }
-    } cleanup;
+    TempFiles cleanup;
     if (o->out.empty()) cleanup.files.push_back(curves_csv);
     io::OutputFile csv(curves_csv, o->out.empty() ? "plot curves" : "--out");
     auto& s = csv.stream();
