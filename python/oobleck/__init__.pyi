@@ -1,4 +1,4 @@
-# Type stubs of the oobleck package (units: see the docstrings in oobleck/__init__.py).
+# Type stubs of the oobleck package (units: see the docstrings in the modules of oobleck/).
 import os
 from typing import Any, Literal, Optional, Sequence, Union, overload
 
@@ -101,6 +101,8 @@ def fit(kind: str, data: Union[pd.DataFrame, str, os.PathLike, Sequence[Union[st
 RHEOMETER_COLUMNS: tuple[str, ...]
 def read_rheometer(path: Union[str, os.PathLike], format: str = "auto", *,
                    step: Optional[Union[str, int]] = None) -> pd.DataFrame: ...
+SHEAR_COLUMNS: tuple[str, ...]
+RELAX_COLUMNS: tuple[str, ...]
 def point_shear(params: ParamsLike, phi: float, *, shear_rate: Optional[float] = None,
                 shear_stress: Optional[float] = None, duration: float, dt: Optional[float] = None,
                 f0: float = 0.0, samples: int = 1000, **overrides: float) -> pd.DataFrame: ...
