@@ -35,7 +35,9 @@ struct Param {
   double lower = -kInf, upper = kInf;  ///< natural units
 };
 
-double& slot(SteadyParams& s, const Param& q) {
+/// The field of `s` that `q` fits (const where `s` is).
+template <class S>
+auto& slot(S& s, const Param& q) {
   switch (q.field) {
     case Param::a_0: return s.a_0;
     case Param::phi_j: return s.phi_j;
@@ -231,10 +233,48 @@ struct Attempt {
   std::optional<Undetermined> undetermined;
 };
 
-Attempt attempt_fit(const std::vector<double>& phi, const std::vector<double>& shear_rate,
-                    const std::vector<double>& shear_stress, const Preset& base, const CurvesFitOptions& options,
-                    const std::vector<std::string>& names) {
-  const std::string& w = options.where;
+/// Ends every message that names an undetermined parameter.
+constexpr const char* kUndeterminedHint =
+    "fix it (leave it out of the fitted parameters, keeping the base value) or add data that depend on it (e.g. "
+    "points above phi_c and above tau_star for phi_c, a_inf and eta_B; low-stress points for a_0 and phi_j)";
+constexpr const char* kConvergenceHint = "start from a base set closer to the data or fit fewer parameters";
+
+// ---- Setup: the fitted parameters, their bounds and start, the data, the Ceres problem. ----
+
+/// The data as CurvesCost reads them: logarithms, the rows grouped by phi, the densest phi.
+struct CurvesData {
+  std::vector<Group> groups;
+  std::vector<double> ln_rate, ln_stress;
+  double max_phi = 0.0;
+};
+
+CurvesData curves_data(const std::vector<double>& phi, const std::vector<double>& shear_rate,
+                       const std::vector<double>& shear_stress) {
+  CurvesData d;
+  d.max_phi = *std::max_element(phi.begin(), phi.end());
+  d.ln_rate.resize(phi.size());
+  d.ln_stress.resize(phi.size());
+  for (std::size_t k = 0; k < phi.size(); ++k) {
+    d.ln_rate[k] = std::log(shear_rate[k]);
+    d.ln_stress[k] = std::log(shear_stress[k]);
+    auto it = std::find_if(d.groups.begin(), d.groups.end(), [&](const Group& g) { return g.phi == phi[k]; });
+    if (it == d.groups.end()) {
+      d.groups.push_back({phi[k], {}});
+      it = d.groups.end() - 1;
+    }
+    it->rows.push_back(static_cast<int>(k));
+  }
+  return d;
+}
+
+bool is_fitted(const std::vector<Param>& params, Param::Field f) {
+  return std::any_of(params.begin(), params.end(), [f](const Param& q) { return q.field == f; });
+}
+
+/// The parameters `names`, in their order; InputError for a name listed twice or unknown, and for
+/// a data phi at or above the base set's phi_j when phi_j is not fitted.
+std::vector<Param> fitted_parameters(const std::vector<std::string>& names, const std::vector<double>& phi,
+                                     const Preset& base, const std::string& w) {
   std::vector<Param> params;
   for (const auto& n : names) {
     for (const auto& q : params) {
@@ -242,11 +282,7 @@ Attempt attempt_fit(const std::vector<double>& phi, const std::vector<double>& s
     }
     params.push_back(parse_param(n, base, w));
   }
-  auto fitted = [&](Param::Field f) {
-    return std::any_of(params.begin(), params.end(), [f](const Param& q) { return q.field == f; });
-  };
-  const double max_phi = *std::max_element(phi.begin(), phi.end());
-  if (!fitted(Param::phi_j)) {
+  if (!is_fitted(params, Param::phi_j)) {
     for (std::size_t k = 0; k < phi.size(); ++k) {
       if (!(phi[k] < base.steady.phi_j)) {
         throw InputError(fmt::format(
@@ -256,17 +292,24 @@ Attempt attempt_fit(const std::vector<double>& phi, const std::vector<double>& s
       }
     }
   }
+  return params;
+}
 
-  // Bounds: the model's rules, then the caller's.
+/// Each parameter's bounds: the model's rules, then the caller's (options.bounds) intersected with
+/// them; InputError for bounds of a parameter not fitted and for bounds that leave no value.
+void set_bounds(std::vector<Param>& params, const Preset& base, double max_phi, const CurvesFitOptions& options,
+                const std::vector<std::string>& names) {
+  const std::string& w = options.where;
+  const bool phi_j_fitted = is_fitted(params, Param::phi_j), phi_c_fitted = is_fitted(params, Param::phi_c);
   for (Param& q : params) {
     switch (q.field) {
       case Param::phi_j:
-        q.lower = std::max(max_phi, fitted(Param::phi_c) ? 0.0 : base.steady.phi_c) + kStrict;
+        q.lower = std::max(max_phi, phi_c_fitted ? 0.0 : base.steady.phi_c) + kStrict;
         q.upper = 1.0 - kStrict;
         break;
       case Param::phi_c:
         q.lower = kStrict;
-        q.upper = (fitted(Param::phi_j) ? 1.0 : base.steady.phi_j) - kStrict;
+        q.upper = (phi_j_fitted ? 1.0 : base.steady.phi_j) - kStrict;
         break;
       case Param::Delta:
         q.lower = 0.0;
@@ -298,83 +341,91 @@ Attempt attempt_fit(const std::vector<double>& phi, const std::vector<double>& s
                                    b.name, b.lower, b.upper));
     }
   }
+}
 
-  // Start: the base set's values, moved into the bounds (phi_j a little above the densest point).
-  const std::size_t P = params.size();
-  std::vector<double> x(P);
-  SteadyParams start = base.steady;
-  for (std::size_t i = 0; i < P; ++i) {
-    Param& q = params[i];
-    double v = slot(start, q);
+/// The start in internal values: the base set's values, moved into the bounds (phi_j a little
+/// above the densest point).
+std::vector<double> start_point(const std::vector<Param>& params, const SteadyParams& base) {
+  std::vector<double> x(params.size());
+  for (std::size_t i = 0; i < params.size(); ++i) {
+    const Param& q = params[i];
+    double v = slot(base, q);
     if (!(v > q.lower)) v = q.field == Param::phi_j ? std::min(q.lower + 0.01, 0.5 * (q.lower + q.upper)) : q.lower;
     if (!(v < q.upper)) v = q.upper;
     if (q.log && !(v > 0.0)) v = 1.0;
     if (q.log && q.field == Param::phi_i && v <= 0.0) v = 1.0;
     x[i] = q.log ? std::log(v) : v;
   }
+  return x;
+}
 
-  std::vector<Group> groups;
-  std::vector<double> ln_rate(phi.size()), ln_stress(phi.size());
-  for (std::size_t k = 0; k < phi.size(); ++k) {
-    ln_rate[k] = std::log(shear_rate[k]);
-    ln_stress[k] = std::log(shear_stress[k]);
-    auto it = std::find_if(groups.begin(), groups.end(), [&](const Group& g) { return g.phi == phi[k]; });
-    if (it == groups.end()) {
-      groups.push_back({phi[k], {}});
-      it = groups.end() - 1;
-    }
-    it->rows.push_back(static_cast<int>(k));
-  }
-  const int n = static_cast<int>(phi.size());
-  auto* functor = new CurvesCost{&params, base.steady, &groups, &ln_rate, &ln_stress, options.residual, max_phi};
-  const CurvesCost& cost_fn = *functor;
-  ceres::Problem problem;  // owns the functor from here on
+/// The Ceres problem: one parameter block `x` (internal values, with the bounds of `params`) and
+/// one residual block over every point (CurvesCost, central-difference Jacobians). `problem` owns
+/// the returned cost functor, which reads `params` and `data`.
+const CurvesCost& build_problem(ceres::Problem& problem, const std::vector<Param>& params, std::vector<double>& x,
+                                const SteadyParams& base, const CurvesData& data, CurvesResidual residual) {
+  const auto P = static_cast<int>(params.size());
+  auto* functor = new CurvesCost{&params, base, &data.groups, &data.ln_rate, &data.ln_stress, residual, data.max_phi};
   auto* cost = new ceres::DynamicNumericDiffCostFunction<CurvesCost, ceres::CENTRAL>(functor);
-  cost->AddParameterBlock(static_cast<int>(P));
-  cost->SetNumResiduals(n);
+  cost->AddParameterBlock(P);
+  cost->SetNumResiduals(static_cast<int>(data.ln_rate.size()));
   problem.AddResidualBlock(cost, nullptr, x.data());
-
-  std::vector<double> r(phi.size()), model(phi.size());
-  int failed = -1;
-  if (!cost_fn.evaluate(x.data(), r.data(), model.data(), &failed)) {
-    if (failed < 0) {
-      throw InputError(
-          fmt::format("{}: the starting parameters (the base set {}, moved into the bounds) break a "
-                      "rule of the model (phi_c < phi_j, phi_j > every data phi = {} ...)",
-                      w, base.name, max_phi));
-    }
-    const auto f = static_cast<std::size_t>(failed);
-    throw InputError(fmt::format(
-        "{}: row {} (phi = {}, shear_rate = {} 1/s, shear_stress = {} Pa): the starting parameters (base set {}) "
-        "have no steady state at this {}; start from a base set closer to the data{}",
-        w, failed + 1, phi[f], shear_rate[f], shear_stress[f], base.name,
-        options.residual == CurvesResidual::rate ? "stress" : "rate (above the fastest steady shear, e.g. DST)",
-        options.residual == CurvesResidual::stress ? " or use the residual 'rate' (stress-controlled matching)" : ""));
-  }
-
-  for (std::size_t i = 0; i < P; ++i) {
-    const Param& q = params[i];
+  for (int i = 0; i < P; ++i) {
+    const Param& q = params[static_cast<std::size_t>(i)];
     const double lo = q.log ? (q.lower > 0.0 ? std::log(q.lower) : -kInf) : q.lower;
     const double hi = q.log ? (std::isfinite(q.upper) ? std::log(q.upper) : kInf) : q.upper;
-    if (std::isfinite(lo)) problem.SetParameterLowerBound(x.data(), static_cast<int>(i), lo);
-    if (std::isfinite(hi)) problem.SetParameterUpperBound(x.data(), static_cast<int>(i), hi);
+    if (std::isfinite(lo)) problem.SetParameterLowerBound(x.data(), i, lo);
+    if (std::isfinite(hi)) problem.SetParameterUpperBound(x.data(), i, hi);
   }
+  return *functor;
+}
+
+/// InputError unless the start has a steady state for every point, naming the first without.
+void check_start(const CurvesCost& cost_fn, const std::vector<double>& x, const std::vector<double>& phi,
+                 const std::vector<double>& shear_rate, const std::vector<double>& shear_stress, const Preset& base,
+                 const CurvesFitOptions& options) {
+  std::vector<double> r(phi.size()), model(phi.size());
+  int failed = -1;
+  if (cost_fn.evaluate(x.data(), r.data(), model.data(), &failed)) return;
+  const std::string& w = options.where;
+  if (failed < 0) {
+    throw InputError(
+        fmt::format("{}: the starting parameters (the base set {}, moved into the bounds) break a "
+                    "rule of the model (phi_c < phi_j, phi_j > every data phi = {} ...)",
+                    w, base.name, cost_fn.max_phi));
+  }
+  const auto f = static_cast<std::size_t>(failed);
+  throw InputError(fmt::format(
+      "{}: row {} (phi = {}, shear_rate = {} 1/s, shear_stress = {} Pa): the starting parameters (base set {}) "
+      "have no steady state at this {}; start from a base set closer to the data{}",
+      w, failed + 1, phi[f], shear_rate[f], shear_stress[f], base.name,
+      options.residual == CurvesResidual::rate ? "stress" : "rate (above the fastest steady shear, e.g. DST)",
+      options.residual == CurvesResidual::stress ? " or use the residual 'rate' (stress-controlled matching)" : ""));
+}
+
+// ---- Solve: Levenberg–Marquardt with bounds, and the residuals at the solution. ----
+
+/// Solves `problem` from x; NumericalError when the cost ends non-finite. A fit that ends
+/// unconverged is diagnosed after the covariance: an undetermined parameter that wanders is the
+/// usual reason (named, or held so that the rest converge).
+ceres::Solver::Summary solve(ceres::Problem& problem, const CurvesFitOptions& options) {
   ceres::Solver::Summary summary;
   ceres::Solve(detail::levenberg_marquardt(options.max_iterations, 1e-10, 1e-10), &problem, &summary);
-  // A fit that does not converge is diagnosed first: an undetermined parameter that wanders is the
-  // usual reason (named, or held so that the rest converge).
-  const char* convergence_hint = "start from a base set closer to the data or fit fewer parameters";
-  const bool converged = summary.termination_type == ceres::CONVERGENCE && std::isfinite(summary.final_cost);
   if (!std::isfinite(summary.final_cost)) {
-    detail::require_convergence(summary, w, "curves", convergence_hint);
+    detail::require_convergence(summary, options.where, "curves", kConvergenceHint);
   }
+  return summary;
+}
 
-  Attempt out;
-  CurvesFitResult& res = out.result;
+/// The result's sizes, cost, iterations, residuals, model values and rms at the solution x.
+CurvesFitResult fit_at_solution(const CurvesCost& cost_fn, const std::vector<double>& x,
+                                const ceres::Solver::Summary& summary, int n, const std::string& w) {
+  CurvesFitResult res;
   res.n = n;
-  res.p = static_cast<int>(P);
+  res.p = static_cast<int>(x.size());
   res.cost = summary.final_cost;
   res.iterations = static_cast<int>(summary.iterations.size());
+  std::vector<double> r(static_cast<std::size_t>(n)), model(static_cast<std::size_t>(n));
   if (!cost_fn.evaluate(x.data(), r.data(), model.data(), nullptr)) {
     throw NumericalError(
         fmt::format("{}: the curves fit ended on parameters without a steady state for every point", w));
@@ -384,8 +435,13 @@ Attempt attempt_fit(const std::vector<double>& phi, const std::vector<double>& s
   double ss = 0.0;
   for (double v : r) ss += v * v;
   res.rms = std::sqrt(ss / n);
+  return res;
+}
 
-  // Jacobian at the solution (internal parameters), scaled to unit columns for the rank test.
+// ---- Covariance: the Jacobian's rank, standard errors, what the data do not determine. ----
+
+/// The Jacobian of the residuals at the solution, in internal parameters (n x P, dense).
+Eigen::MatrixXd jacobian_at_solution(ceres::Problem& problem, int n, std::size_t P) {
   double cost_at = 0.0;
   ceres::CRSMatrix crs;
   problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost_at, nullptr, nullptr, &crs);
@@ -395,70 +451,67 @@ Attempt attempt_fit(const std::vector<double>& phi, const std::vector<double>& s
       J(row, crs.cols[static_cast<std::size_t>(k)]) = crs.values[static_cast<std::size_t>(k)];
     }
   }
-  Eigen::VectorXd scale(static_cast<Eigen::Index>(P));
+  return J;
+}
+
+/// The parameters the residuals do not change with (columns of zeros in J), all held; sets
+/// `scale` to the inverse column norms (1 for a column of zeros), the scaling of the rank test.
+std::optional<Undetermined> flat_columns(const Eigen::MatrixXd& J, const std::vector<Param>& params,
+                                         const SteadyParams& base, const std::string& w, Eigen::VectorXd& scale) {
+  scale.resize(static_cast<Eigen::Index>(params.size()));
   std::vector<std::string> flat;
   std::vector<HeldParameter> flat_held;
-  for (std::size_t i = 0; i < P; ++i) {
+  for (std::size_t i = 0; i < params.size(); ++i) {
     const double norm = J.col(static_cast<Eigen::Index>(i)).norm();
     if (!(norm > 0.0)) {
       flat.push_back(params[i].name);
-      flat_held.push_back({params[i].name, slot(start, params[i]), "the residuals do not change with it"});
+      flat_held.push_back({params[i].name, slot(base, params[i]), "the residuals do not change with it"});
     }
     scale(static_cast<Eigen::Index>(i)) = norm > 0.0 ? 1.0 / norm : 1.0;
   }
-  const std::string hint =
-      "fix it (leave it out of the fitted parameters, keeping the base value) or add data that depend on it (e.g. "
-      "points above phi_c and above tau_star for phi_c, a_inf and eta_B; low-stress points for a_0 and phi_j)";
-  if (!flat.empty()) {
-    out.undetermined =
-        Undetermined{fmt::format("{}: the data do not determine {} (the residuals do not change with {}); {}", w,
-                                 fmt::join(flat, ", "), flat.size() == 1 ? "it" : "them", hint),
-                     flat_held};
-    return out;
-  }
-  const Eigen::MatrixXd Js = J * scale.asDiagonal();
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(Js, Eigen::ComputeThinV);
+  if (flat.empty()) return std::nullopt;
+  return Undetermined{fmt::format("{}: the data do not determine {} (the residuals do not change with {}); {}", w,
+                                  fmt::join(flat, ", "), flat.size() == 1 ? "it" : "them", kUndeterminedHint),
+                      flat_held};
+}
+
+/// A rank-deficient scaled Jacobian (smallest singular value below kCondition times the largest):
+/// the parameters in its null vector, held the one with the largest component.
+std::optional<Undetermined> rank_deficiency(const Eigen::JacobiSVD<Eigen::MatrixXd>& svd,
+                                            const std::vector<Param>& params, const SteadyParams& base,
+                                            const std::string& w) {
   const Eigen::VectorXd& sv = svd.singularValues();
-  const auto last = static_cast<Eigen::Index>(P) - 1;
-  if (!(sv(last) > kCondition * sv(0))) {
-    const Eigen::VectorXd v = svd.matrixV().col(last);
-    std::vector<std::string> involved;
-    Eigen::Index largest = 0;
-    for (std::size_t i = 0; i < P; ++i) {
-      const auto ii = static_cast<Eigen::Index>(i);
-      if (std::fabs(v(ii)) > 0.25) involved.push_back(params[i].name);
-      if (std::fabs(v(ii)) > std::fabs(v(largest))) largest = ii;
-    }
-    const std::string why = fmt::format(
-        "the Jacobian is rank-deficient: a combination of {} leaves every residual unchanged; condition {:.2g}",
-        fmt::join(involved, ", "), sv(0) / sv(last));
-    out.undetermined = Undetermined{
-        fmt::format("{}: the data do not determine {} (the Jacobian is rank-deficient: a combination of {} leaves "
-                    "every residual unchanged; condition {:.2g}); {}",
-                    w, fmt::join(involved, ", "), involved.size() == 1 ? "this parameter" : "these parameters",
-                    sv(0) / sv(last), hint),
-        {{params[static_cast<std::size_t>(largest)].name, slot(start, params[static_cast<std::size_t>(largest)]),
-          why}}};
-    return out;
+  const auto last = static_cast<Eigen::Index>(params.size()) - 1;
+  if (sv(last) > kCondition * sv(0)) return std::nullopt;
+  const Eigen::VectorXd v = svd.matrixV().col(last);
+  std::vector<std::string> involved;
+  Eigen::Index largest = 0;
+  for (std::size_t i = 0; i < params.size(); ++i) {
+    const auto ii = static_cast<Eigen::Index>(i);
+    if (std::fabs(v(ii)) > 0.25) involved.push_back(params[i].name);
+    if (std::fabs(v(ii)) > std::fabs(v(largest))) largest = ii;
   }
-  // Covariance of the internal parameters: D V S^-2 V^T D s^2, then to natural units.
-  const double s2 = n > res.p ? 2.0 * res.cost / (n - res.p) : 0.0;
-  const Eigen::MatrixXd& V = svd.matrixV();
-  const Eigen::VectorXd inv_s2 = sv.array().square().inverse();
-  Eigen::MatrixXd cov = scale.asDiagonal() * V * inv_s2.asDiagonal() * V.transpose() * scale.asDiagonal() * s2;
-  Eigen::VectorXd dq(static_cast<Eigen::Index>(P));
-  res.fitted = base;
-  for (std::size_t i = 0; i < P; ++i) {
-    const double value = params[i].log ? std::exp(x[i]) : x[i];
-    dq(static_cast<Eigen::Index>(i)) = params[i].log ? value : 1.0;
-    slot(res.fitted.steady, params[i]) = value;
-  }
-  // Determined, but so loosely that the value means nothing: a 1-sigma range wider than a factor
-  // of 1000 for the positive scales, 0.1 for a volume fraction, 10 for an exponent, 1 for Delta.
+  const std::string why = fmt::format(
+      "the Jacobian is rank-deficient: a combination of {} leaves every residual unchanged; condition {:.2g}",
+      fmt::join(involved, ", "), sv(0) / sv(last));
+  const Param& held = params[static_cast<std::size_t>(largest)];
+  return Undetermined{
+      fmt::format("{}: the data do not determine {} (the Jacobian is rank-deficient: a combination of {} leaves "
+                  "every residual unchanged; condition {:.2g}); {}",
+                  w, fmt::join(involved, ", "), involved.size() == 1 ? "this parameter" : "these parameters",
+                  sv(0) / sv(last), kUndeterminedHint),
+      {{held.name, slot(base, held), why}}};
+}
+
+/// Parameters determined so loosely that the value means nothing: a 1-sigma range (from the
+/// internal covariance `cov`) wider than a factor of 1000 for the positive scales, 0.1 for a volume
+/// fraction, 10 for an exponent, 1 for Delta; held the one furthest beyond its limit.
+std::optional<Undetermined> loose_parameters(const Eigen::MatrixXd& cov, const std::vector<Param>& params,
+                                             const SteadyParams& base, const std::string& w) {
   std::vector<std::string> loose;
   double loosest = 0.0;
   HeldParameter loosest_held;
-  for (std::size_t i = 0; i < P; ++i) {
+  for (std::size_t i = 0; i < params.size(); ++i) {
     const double se = std::sqrt(cov(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)));
     const Param& q = params[i];
     const double limit = q.log                     ? std::log(1000.0)
@@ -473,18 +526,48 @@ Attempt attempt_fit(const std::vector<double>& phi, const std::vector<double>& s
       if (loosest_held.name.empty() || ratio > loosest) {
         loosest = ratio;
         loosest_held = {
-            q.name, slot(start, q),
+            q.name, slot(base, q),
             fmt::format("{}, beyond {}", range, q.log ? std::string("a factor 1000") : fmt::format("+- {:g}", limit))};
       }
     }
   }
-  if (!loose.empty()) {
-    out.undetermined = Undetermined{
-        fmt::format("{}: the data do not determine {}; {}", w, fmt::join(loose, ", "), hint), {loosest_held}};
-    return out;
+  if (loose.empty()) return std::nullopt;
+  return Undetermined{fmt::format("{}: the data do not determine {}; {}", w, fmt::join(loose, ", "), kUndeterminedHint),
+                      {loosest_held}};
+}
+
+/// Covariance of the internal parameters from the Jacobian at the solution, D V S^-2 V^T D s^2
+/// (D: the column scaling, s^2 = 2 cost/(n - p)), or what the data do not determine: flat columns,
+/// a rank-deficient Jacobian, loose parameters, checked in this order.
+std::optional<Undetermined> internal_covariance(ceres::Problem& problem, const std::vector<Param>& params,
+                                                const SteadyParams& base, const CurvesFitResult& res,
+                                                const std::string& w, Eigen::MatrixXd& cov) {
+  const Eigen::MatrixXd J = jacobian_at_solution(problem, res.n, params.size());
+  Eigen::VectorXd scale;
+  if (auto u = flat_columns(J, params, base, w, scale)) return u;
+  const Eigen::MatrixXd Js = J * scale.asDiagonal();
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(Js, Eigen::ComputeThinV);
+  if (auto u = rank_deficiency(svd, params, base, w)) return u;
+  const double s2 = res.n > res.p ? 2.0 * res.cost / (res.n - res.p) : 0.0;
+  const Eigen::MatrixXd& V = svd.matrixV();
+  const Eigen::VectorXd inv_s2 = svd.singularValues().array().square().inverse();
+  cov = scale.asDiagonal() * V * inv_s2.asDiagonal() * V.transpose() * scale.asDiagonal() * s2;
+  return loose_parameters(cov, params, base, w);
+}
+
+/// The fitted set, the parameters with their standard errors, and the covariance and correlation
+/// in natural units (the internal covariance `cov` through d value/d internal).
+void store_fitted(CurvesFitResult& res, const Preset& base, const std::vector<Param>& params,
+                  const std::vector<double>& x, const Eigen::MatrixXd& internal_cov) {
+  const std::size_t P = params.size();
+  Eigen::VectorXd dq(static_cast<Eigen::Index>(P));
+  res.fitted = base;
+  for (std::size_t i = 0; i < P; ++i) {
+    const double value = params[i].log ? std::exp(x[i]) : x[i];
+    dq(static_cast<Eigen::Index>(i)) = params[i].log ? value : 1.0;
+    slot(res.fitted.steady, params[i]) = value;
   }
-  if (!converged) detail::require_convergence(summary, w, "curves", convergence_hint);
-  cov = dq.asDiagonal() * cov * dq.asDiagonal();
+  const Eigen::MatrixXd cov = dq.asDiagonal() * internal_cov * dq.asDiagonal();
   res.covariance.resize(P * P);
   res.correlation.resize(P * P);
   for (std::size_t i = 0; i < P; ++i) {
@@ -496,8 +579,30 @@ Attempt attempt_fit(const std::vector<double>& phi, const std::vector<double>& s
       res.correlation[i * P + j] = cov(ii, jj) / std::sqrt(cov(ii, ii) * cov(jj, jj));
     }
   }
+}
+
+Attempt attempt_fit(const std::vector<double>& phi, const std::vector<double>& shear_rate,
+                    const std::vector<double>& shear_stress, const Preset& base, const CurvesFitOptions& options,
+                    const std::vector<std::string>& names) {
+  const std::string& w = options.where;
+  std::vector<Param> params = fitted_parameters(names, phi, base, w);
+  const CurvesData data = curves_data(phi, shear_rate, shear_stress);
+  set_bounds(params, base, data.max_phi, options, names);
+  std::vector<double> x = start_point(params, base.steady);
+  ceres::Problem problem;
+  const CurvesCost& cost_fn = build_problem(problem, params, x, base.steady, data, options.residual);
+  check_start(cost_fn, x, phi, shear_rate, shear_stress, base, options);
+
+  const ceres::Solver::Summary summary = solve(problem, options);
+  Attempt out{fit_at_solution(cost_fn, x, summary, static_cast<int>(phi.size()), w), std::nullopt};
+
+  Eigen::MatrixXd cov;
+  out.undetermined = internal_covariance(problem, params, base.steady, out.result, w, cov);
+  if (out.undetermined) return out;
+  detail::require_convergence(summary, w, "curves", kConvergenceHint);
+  store_fitted(out.result, base, params, x, cov);
   try {
-    validate(res.fitted, w);
+    validate(out.result.fitted, w);
   } catch (const InputError& e) {
     throw NumericalError(fmt::format("the fitted parameters break a rule: {}", e.what()));
   }
