@@ -344,6 +344,113 @@ std::string held_names(const rheology::CurvesFitResult& r) {
   return fmt::format("{}", fmt::join(names, ", "));
 }
 
+/// Writes the parameter file `out`, then moves the plot's temporary `tmp_png` (none: "") to `png`;
+/// a failed write removes the temporary.
+void write_fit_files(const std::string& out, const std::string& toml, const std::string& tmp_png,
+                     const std::string& png) {
+  try {
+    io::write_file_atomically(out, toml, "--out");
+  } catch (...) {
+    if (!tmp_png.empty()) {
+      std::error_code ec;
+      fs::remove(tmp_png, ec);
+    }
+    throw;
+  }
+  if (!tmp_png.empty()) fs::rename(tmp_png, png);
+}
+
+/// The fitted parameters, one a line (value, standard error, unit, relative error), names padded
+/// to the longest; returns that width.
+std::size_t print_parameters(const std::vector<rheology::FittedParameter>& parameters) {
+  std::size_t width = 0;
+  for (const auto& p : parameters) width = std::max(width, p.name.size());
+  for (const auto& p : parameters) {
+    const double rel = std::abs(p.std_error / p.value);
+    fmt::print("  {:<{}} = {:<12.6g} +- {:<10}  {:<11}{}\n", p.name, width, p.value, fmt_se(p.std_error),
+               unit_of(p.name), std::isfinite(rel) ? fmt::format("({:.2g} %)", 100.0 * rel) : "");
+  }
+  return width;
+}
+
+/// --parameters: the comma-separated names, spaces dropped.
+std::vector<std::string> parameter_list(const std::string& text) {
+  std::vector<std::string> names;
+  if (text.empty()) return names;
+  std::string item;
+  for (char c : text + ",") {
+    if (c == ',') {
+      if (!item.empty()) names.push_back(item);
+      item.clear();
+    } else if (c != ' ') {
+      item += c;
+    }
+  }
+  return names;
+}
+
+/// Header comments of the curves fit's parameter file: what was fitted, with standard errors, and
+/// what was held.
+std::string curves_toml_header(const CurvesOpts& o, const rheology::CurvesFitResult& r, const rheology::Preset& preset,
+                               rheology::CurvesResidual residual) {
+  std::string h = fmt::format("# oobleck parameter set fitted by: oobleck rheology fit --kind curves {}\n",
+                              sanitize(o.args.empty() ? "--data " + o.data : o.args));
+  h += fmt::format("# base set: {} ({}); every value not listed below is the base value\n", sanitize(preset.name),
+                   sanitize(preset.file));
+  h += fmt::format(
+      "# fitted values with 1-sigma standard errors ((J^T J)^-1 s^2, s^2 = 2 cost/(n - p)); residual: ln {}\n",
+      rheology::to_string(residual) == "rate" ? "shear rate at the measured stress"
+                                              : "shear stress at the measured rate");
+  for (const auto& p : r.parameters) {
+    h += fmt::format("#   {} = {:.8g} +- {} {}\n", p.name, p.value, fmt_se(p.std_error), unit_of(p.name));
+  }
+  if (!r.held.empty()) {
+    h += "# held at the base set's values because the data do not determine them (--strict: an error instead):\n";
+    for (const auto& p : r.held) {
+      h += fmt::format("#   {} = {:.8g} {}: {}\n", p.name, p.value, unit_of(p.name), sanitize(p.reason));
+    }
+  }
+  h += fmt::format("# n = {} points, p = {} parameters, rms log residual = {:.4g}\n\n", r.n, r.p, r.rms);
+  return h;
+}
+
+/// The curves fit's result: one JSON object (--json) or the text report.
+void print_curves_result(const CurvesOpts& o, const rheology::CurvesFitResult& r, const rheology::Preset& preset,
+                         rheology::CurvesResidual residual, const std::string& note) {
+  if (o.json) {
+    nlohmann::json params = nlohmann::json::object();
+    for (const auto& p : r.parameters) params[p.name] = {{"value", p.value}, {"std_error", p.std_error}};
+    nlohmann::json j = {{"kind", "curves"},
+                        {"parameters", params},
+                        {"n", r.n},
+                        {"rms", r.rms},
+                        {"iterations", r.iterations},
+                        {"base", preset.name},
+                        {"out", o.out},
+                        {"residual", rheology::to_string(residual)},
+                        {"correlation", r.correlation}};
+    nlohmann::json order = nlohmann::json::array();  // "parameters" is an object: its keys come sorted
+    for (const auto& p : r.parameters) order.push_back(p.name);
+    j["correlation_order"] = order;
+    nlohmann::json held = nlohmann::json::array();
+    for (const auto& p : r.held) held.push_back({{"name", p.name}, {"value", p.value}, {"reason", p.reason}});
+    j["held"] = held;
+    if (!note.empty()) j["note"] = note;
+    fmt::print("{}\n", j.dump());
+    return;
+  }
+  fmt::print("base parameter set: {} ({}) [{} units]\n", preset.name, preset.file, preset.units);
+  fmt::print("fit --kind curves to {}: n = {} points, p = {} parameters; Ceres converged ({} iterations)\n", o.data,
+             r.n, r.p, r.iterations);
+  const std::size_t width = print_parameters(r.parameters);
+  for (const auto& p : r.held) {
+    fmt::print("  {:<{}} = {:<12.6g} held (base value)  {}\n", p.name, width, p.value, unit_of(p.name));
+  }
+  fmt::print("rms log residual = {:.4g} (n = {}, residual: ln {})\n", r.rms, r.n, rheology::to_string(residual));
+  fmt::print("wrote {}\n", o.out);
+  if (!o.png.empty()) fmt::print("wrote {}\n", o.png);
+}
+
 void fit_curves_command(const CurvesOpts& o, const io::CsvTable& t, rheology::Preset preset, const std::string& note) {
   for (const char* c : {"phi", "shear_rate", "shear_stress"}) {
     if (!t.has_column(c)) {
@@ -357,17 +464,7 @@ void fit_curves_command(const CurvesOpts& o, const io::CsvTable& t, rheology::Pr
   options.where = o.data;
   options.residual = rheology::parse_curves_residual(o.residual, "--residual");
   options.strict = o.strict;
-  if (!o.parameters.empty()) {
-    std::string item;
-    for (char c : o.parameters + ",") {
-      if (c == ',') {
-        if (!item.empty()) options.parameters.push_back(item);
-        item.clear();
-      } else if (c != ' ') {
-        item += c;
-      }
-    }
-  }
+  options.parameters = parameter_list(o.parameters);
   io::check_writable(o.out, "--out");
   if (!o.png.empty()) io::check_writable(o.png, "--plot");
   const auto r =
@@ -376,24 +473,7 @@ void fit_curves_command(const CurvesOpts& o, const io::CsvTable& t, rheology::Pr
   fitted.name = sanitize(fs::path(o.out).stem().string());
   fitted.source = sanitize(
       fmt::format("oobleck rheology fit --kind curves to {}; base {}: {}", o.names(), preset.name, preset.source));
-  std::string h = fmt::format("# oobleck parameter set fitted by: oobleck rheology fit --kind curves {}\n",
-                              sanitize(o.args.empty() ? "--data " + o.data : o.args));
-  h += fmt::format("# base set: {} ({}); every value not listed below is the base value\n", sanitize(preset.name),
-                   sanitize(preset.file));
-  h += fmt::format(
-      "# fitted values with 1-sigma standard errors ((J^T J)^-1 s^2, s^2 = 2 cost/(n - p)); residual: ln {}\n",
-      rheology::to_string(options.residual) == "rate" ? "shear rate at the measured stress"
-                                                      : "shear stress at the measured rate");
-  for (const auto& p : r.parameters) {
-    h += fmt::format("#   {} = {:.8g} +- {} {}\n", p.name, p.value, fmt_se(p.std_error), unit_of(p.name));
-  }
-  if (!r.held.empty()) {
-    h += "# held at the base set's values because the data do not determine them (--strict: an error instead):\n";
-    for (const auto& p : r.held) {
-      h += fmt::format("#   {} = {:.8g} {}: {}\n", p.name, p.value, unit_of(p.name), sanitize(p.reason));
-    }
-  }
-  h += fmt::format("# n = {} points, p = {} parameters, rms log residual = {:.4g}\n\n", r.n, r.p, r.rms);
+  const std::string h = curves_toml_header(o, r, preset, options.residual);
   // The warning goes to stderr in both output modes, before anything is written.
   for (const auto& p : r.held) {
     fmt::print(stderr, "warning: {} held at the base value {:.6g} {}: the data do not determine it ({})\n", p.name,
@@ -410,55 +490,170 @@ void fit_curves_command(const CurvesOpts& o, const io::CsvTable& t, rheology::Pr
                                           r.held.empty() ? "" : "\nheld at the base values: " + held_names(r)),
                               o.png);
   }
-  try {
-    io::write_file_atomically(o.out, h + rheology::to_toml(fitted), "--out");
-  } catch (...) {
-    if (!tmp_png.empty()) {
-      std::error_code ec;
-      fs::remove(tmp_png, ec);
-    }
-    throw;
+  write_fit_files(o.out, h + rheology::to_toml(fitted), tmp_png, o.png);
+  print_curves_result(o, r, preset, options.residual, note);
+}
+
+/// The options of `oobleck rheology fit`, with the ones whose presence the kinds check.
+struct FitArgs {
+  ParamsOption params;
+  std::string kind, data, out, png;
+  std::vector<std::string> files, steps;
+  std::vector<double> phi;
+  int terms = 0;
+  bool json = false, strict = false;
+  std::string parameters, residual = "rate";
+  CLI::App* cmd = nullptr;
+  CLI::Option *data_opt = nullptr, *phi_opt = nullptr, *step_opt = nullptr, *terms_opt = nullptr;
+  CLI::Option *parameters_opt = nullptr, *residual_opt = nullptr, *strict_opt = nullptr;
+
+  /// True when neither --preset nor --params is given (the default base, with a note).
+  bool default_base() const { return params.preset.empty() && params.params.empty(); }
+};
+
+std::string default_base_note() {
+  return fmt::format("no --preset or --params given: using the {} preset as the base parameter set", kDefaultPreset);
+}
+
+/// `--kind curves`: the joint fit of whole flow curves from a CSV or instrument exports.
+void fit_kind_curves(const FitArgs& a) {
+  if (a.terms_opt->count() > 0)
+    throw InputError(fmt::format("--terms = {}: only for --kind dst (not curves)", a.terms));
+  std::string note;
+  if (a.default_base()) {
+    note = default_base_note();
+    fmt::print(a.json ? stderr : stdout, "{}\n", note);
   }
-  if (!tmp_png.empty()) fs::rename(tmp_png, o.png);
-  if (o.json) {
+  const rheology::Preset base = a.params.load(kDefaultPreset);
+  const FlowCurveData d = read_flow_curve_data(*a.cmd, a.data_opt, a.step_opt, a.files, a.steps, a.phi, a.json);
+  fit_curves_command({a.data, a.out, a.parameters, a.residual, a.png, a.json, a.strict, d.args}, d.table, base, note);
+}
+
+/// The warning for an asymptote fit whose rms log residual exceeds 0.1, with what to check; "" below.
+std::string rms_warning(const rheology::FitResult& r, rheology::FitKind kind, const rheology::Preset& preset) {
+  if (!(r.rms > 0.1)) return "";
+  const std::string hint =
+      kind == rheology::FitKind::dst
+          ? fmt::format(
+                "check the units (shear_rate_dst in 1/s), the base set (phi_c, phi_j, tau_star, eta_0 = "
+                "{} Pa s) and the number of eta_B terms (--terms)",
+                preset.steady.eta_0)
+          : fmt::format(
+                "check the units (viscosity in Pa s, eta_0 = {} Pa s of the base set) and that the "
+                "points are {} viscosities",
+                preset.steady.eta_0, kind == rheology::FitKind::low ? "minimum" : "plateau (maximum)");
+  return fmt::format(
+      "warning: rms log residual {:.3g} > 0.1 (more than 10 % scatter): the fitted {} "
+      "asymptote does not describe these data well; {}",
+      r.rms, rheology::to_string(kind), hint);
+}
+
+/// An asymptote fit's result: one JSON object (--json; the warning on stderr) or the text report.
+void print_asymptote_result(const FitArgs& a, const rheology::FitResult& r, rheology::FitKind kind,
+                            const rheology::Preset& preset, const std::string& note) {
+  const std::string warning = rms_warning(r, kind, preset);
+  if (a.json) {
+    if (!warning.empty()) fmt::print(stderr, "{}\n", warning);
     nlohmann::json params = nlohmann::json::object();
-    for (const auto& p : r.parameters) params[p.name] = {{"value", p.value}, {"std_error", p.std_error}};
-    nlohmann::json j = {{"kind", "curves"},
-                        {"parameters", params},
-                        {"n", r.n},
-                        {"rms", r.rms},
-                        {"iterations", r.iterations},
-                        {"base", preset.name},
-                        {"out", o.out},
-                        {"residual", rheology::to_string(options.residual)},
-                        {"correlation", r.correlation}};
-    nlohmann::json order = nlohmann::json::array();  // "parameters" is an object: its keys come sorted
-    for (const auto& p : r.parameters) order.push_back(p.name);
-    j["correlation_order"] = order;
-    nlohmann::json held = nlohmann::json::array();
-    for (const auto& p : r.held) held.push_back({{"name", p.name}, {"value", p.value}, {"reason", p.reason}});
-    j["held"] = held;
+    for (const auto& p : r.parameters) {
+      params[p.name] = {{"value", p.value},
+                        {"std_error", std::isfinite(p.std_error) ? nlohmann::json(p.std_error) : nlohmann::json()}};
+    }
+    nlohmann::json j = {{"kind", rheology::to_string(kind)}, {"parameters", params}, {"n", r.n},    {"rms", r.rms},
+                        {"iterations", r.iterations},        {"base", preset.name},  {"out", a.out}};
     if (!note.empty()) j["note"] = note;
     fmt::print("{}\n", j.dump());
     return;
   }
-  fmt::print("base parameter set: {} ({}) [{} units]\n", preset.name, preset.file, preset.units);
-  fmt::print("fit --kind curves to {}: n = {} points, p = {} parameters; Ceres converged ({} iterations)\n", o.data,
+  fmt::print("base parameter set: {} ({}) [{} units]; mu_c = {} (fixed)\n", preset.name, preset.file, preset.units,
+             preset.steady.mu_c);
+  fmt::print("fit --kind {} to {}: n = {} points, p = {} parameters; Ceres converged ({} iterations)\n", a.kind, a.data,
              r.n, r.p, r.iterations);
-  std::size_t width = 0;
-  for (const auto& p : r.parameters) width = std::max(width, p.name.size());
-  for (const auto& p : r.parameters) {
-    const double rel = std::abs(p.std_error / p.value);
-    fmt::print("  {:<{}} = {:<12.6g} +- {:<10}  {:<11}{}\n", p.name, width, p.value, fmt_se(p.std_error),
-               unit_of(p.name), std::isfinite(rel) ? fmt::format("({:.2g} %)", 100.0 * rel) : "");
+  print_parameters(r.parameters);
+  if (!r.covariance_ok) {
+    fmt::print(
+        "  standard errors n/a: the parameters are not all identifiable from these data (rank-deficient "
+        "Jacobian){}\n",
+        kind == rheology::FitKind::dst ? "; fit fewer eta_B terms (--terms)" : "");
   }
-  for (const auto& p : r.held) {
-    fmt::print("  {:<{}} = {:<12.6g} held (base value)  {}\n", p.name, width, p.value, unit_of(p.name));
+  fmt::print("rms log residual = {:.4g} (n = {})\n", r.rms, r.n);
+  if (!warning.empty()) fmt::print("{}\n", warning);
+  fmt::print("wrote {}\n", a.out);
+  if (!a.png.empty()) fmt::print("wrote {}\n", a.png);
+}
+
+/// `--kind low`, `high` and `dst`: the asymptote `kind` (E12, E13, E14) fitted to one CSV.
+void fit_kind_asymptote(const FitArgs& a, rheology::FitKind kind) {
+  rheology::FitOptions options;
+  if (a.terms_opt->count() > 0) {
+    if (kind != rheology::FitKind::dst) {
+      throw InputError(fmt::format("--terms = {}: only for --kind dst (not {})", a.terms, a.kind));
+    }
+    if (a.terms < 1) throw InputError(fmt::format("--terms = {}: must be >= 1", a.terms));
+    options.terms = a.terms;
   }
-  fmt::print("rms log residual = {:.4g} (n = {}, residual: ln {})\n", r.rms, r.n,
-             rheology::to_string(options.residual));
-  fmt::print("wrote {}\n", o.out);
-  if (!o.png.empty()) fmt::print("wrote {}\n", o.png);
+  const rheology::Preset preset = a.params.load(kDefaultPreset);
+  std::string note;
+  if (a.default_base()) {
+    note = default_base_note();
+    fmt::print(a.json ? stderr : stdout, "{}\n", note);
+  }
+  const Data d = read_data(a.data, kind, preset.steady.eta_0);
+  options.where = a.data;
+  rheology::validate_fit_data(kind, d.phi, d.values, preset.steady, options);
+  io::check_writable(a.out, "--out");
+  if (!a.png.empty()) io::check_writable(a.png, "--plot");
+
+  const rheology::FitResult r = rheology::fit(kind, d.phi, d.values, preset.steady, options);
+
+  rheology::Preset fitted = preset;
+  fitted.steady = r.params;
+  fitted.name = sanitize(fs::path(a.out).stem().string());
+  fitted.source = sanitize(fmt::format("oobleck rheology fit --kind {} to {}; base {}: {}", a.kind,
+                                       fs::path(a.data).filename().string(), preset.name, preset.source));
+  try {
+    rheology::validate(fitted, a.out);
+  } catch (const InputError& e) {
+    throw NumericalError(fmt::format("the fitted parameters break a rule: {}", e.what()));
+  }
+  std::string tmp_png;
+  if (!a.png.empty()) {
+    tmp_png = plot_fit(
+        r, d, fmt::format("{}: fit --kind {} (base {})", fs::path(a.data).filename().string(), a.kind, preset.name),
+        a.png);
+  }
+  const std::string base_desc = fmt::format("{} ({})", preset.name, preset.file);
+  write_fit_files(a.out, toml_header(r, a.data, base_desc) + rheology::to_toml(fitted), tmp_png, a.png);
+  print_asymptote_result(a, r, kind, preset, note);
+}
+
+/// Checks --kind and the options that belong to other kinds, then runs the kind's fit.
+void run_fit(FitArgs& a) {
+  if (a.kind != "low" && a.kind != "high" && a.kind != "dst" && a.kind != "curves") {
+    throw InputError(
+        fmt::format("--kind = '{}': must be one of low (a_0, phi_j from minimum viscosities, E12), high (a_inf, "
+                    "phi_c from plateau viscosities, E13), dst (eta_B terms from DST rates, E14), curves (joint "
+                    "fit to whole flow curves: phi, shear_rate, shear_stress)",
+                    a.kind));
+  }
+  if (a.kind != "curves") {
+    for (auto* opt : {a.phi_opt, a.step_opt}) {
+      if (opt->count() > 0)
+        throw InputError(
+            fmt::format("{}: only for --kind curves with instrument exports (not {})", opt->get_name(), a.kind));
+    }
+    if (a.files.size() != 1)
+      throw InputError(fmt::format("--data given {} times: --kind {} reads one CSV", a.files.size(), a.kind));
+  }
+  a.data = fmt::format("{}", fmt::join(a.files, ", "));
+  if (a.kind == "curves") {
+    fit_kind_curves(a);
+    return;
+  }
+  for (auto* opt : {a.parameters_opt, a.residual_opt, a.strict_opt}) {
+    if (opt->count() > 0) throw InputError(fmt::format("{}: only for --kind curves (not {})", opt->get_name(), a.kind));
+  }
+  fit_kind_asymptote(a, rheology::parse_fit_kind(a.kind, "--kind"));
 }
 
 }  // namespace
@@ -468,188 +663,39 @@ void add_fit_command(CLI::App& rheology) {
       "fit",
       "fit model parameters to rheometer data with Ceres: low (a_0, phi_j; E12), high (a_inf, phi_c; E13), "
       "dst (eta_B terms; E14), curves (joint fit of whole flow curves)");
-  struct Opts {
-    ParamsOption params;
-    std::string kind, data, out, png;
-    std::vector<std::string> files, steps;
-    std::vector<double> phi;
-    int terms = 0;
-    bool json = false, strict = false;
-    std::string parameters, residual = "rate";
-  };
-  auto o = std::make_shared<Opts>();
-  cmd->add_option("--kind", o->kind, "low | high | dst | curves")->required();
-  auto* data = cmd->add_option("--data", o->files,
-                               "CSV with columns phi,viscosity [Pa s] or phi,relative_viscosity (low, high); "
-                               "phi,shear_rate_dst [1/s] (dst); phi,shear_rate [1/s],shear_stress [Pa] (curves); "
-                               "curves: or an instrument export (TRIOS, RheoCompass, rSpace, CSV with units) with "
-                               "--phi, repeated once per volume fraction")
-                   ->required();
-  auto* phi = cmd->add_option("--phi", o->phi,
-                              "curves only: the volume fraction of the --data export before it (one per --data)");
-  auto* step = cmd->add_option("--step", o->steps,
-                               "curves only: the export's step, NAME (case-insensitive, TRIOS's ' - N' optional) or "
-                               "1-based INDEX; after a --data for that file, before the first --data for all "
-                               "(default: the one step with shear rate and stress)");
-  o->params.add_to(cmd);
-  cmd->add_option("--out", o->out, "fitted parameter file (TOML) to write")->required();
-  cmd->add_option("--plot", o->png,
+  auto a = std::make_shared<FitArgs>();
+  a->cmd = cmd;
+  cmd->add_option("--kind", a->kind, "low | high | dst | curves")->required();
+  a->data_opt = cmd->add_option("--data", a->files,
+                                "CSV with columns phi,viscosity [Pa s] or phi,relative_viscosity (low, high); "
+                                "phi,shear_rate_dst [1/s] (dst); phi,shear_rate [1/s],shear_stress [Pa] (curves); "
+                                "curves: or an instrument export (TRIOS, RheoCompass, rSpace, CSV with units) with "
+                                "--phi, repeated once per volume fraction")
+                    ->required();
+  a->phi_opt = cmd->add_option("--phi", a->phi,
+                               "curves only: the volume fraction of the --data export before it (one per --data)");
+  a->step_opt = cmd->add_option("--step", a->steps,
+                                "curves only: the export's step, NAME (case-insensitive, TRIOS's ' - N' optional) or "
+                                "1-based INDEX; after a --data for that file, before the first --data for all "
+                                "(default: the one step with shear rate and stress)");
+  a->params.add_to(cmd);
+  cmd->add_option("--out", a->out, "fitted parameter file (TOML) to write")->required();
+  cmd->add_option("--plot", a->png,
                   "also plot data and fitted curve (curves: the flow curves and the residuals) to this PNG");
-  auto* terms = cmd->add_option("--terms", o->terms,
-                                "dst only: number of eta_B terms to fit (default: as many as the base set has, or 1)");
-  cmd->add_flag("--json", o->json,
+  a->terms_opt = cmd->add_option("--terms", a->terms,
+                                 "dst only: number of eta_B terms to fit (default: as many as the base set has, or 1)");
+  cmd->add_flag("--json", a->json,
                 "print one JSON object {\"kind\", \"parameters\": {name: {\"value\", \"std_error\"}}, \"n\", \"rms\"}");
-  auto* parameters = cmd->add_option(
-      "--parameters", o->parameters,
+  a->parameters_opt = cmd->add_option(
+      "--parameters", a->parameters,
       "curves only: fitted parameters, comma-separated (default a_0,phi_j,a_inf,phi_c,tau_star and every eta_B term)");
-  auto* residual = cmd->add_option("--residual", o->residual,
-                                   "curves only: rate (ln shear rate at the measured stress) or stress (ln shear "
-                                   "stress at the measured rate)");
-  auto* strict = cmd->add_flag("--strict", o->strict,
-                               "curves only: a parameter the data do not determine is an error (default: it is held "
-                               "at the base set's value, with a warning naming it)");
-  cmd->callback([o, cmd, data, phi, step, terms, parameters, residual, strict] {
-    if (o->kind != "low" && o->kind != "high" && o->kind != "dst" && o->kind != "curves") {
-      throw InputError(
-          fmt::format("--kind = '{}': must be one of low (a_0, phi_j from minimum viscosities, E12), high (a_inf, "
-                      "phi_c from plateau viscosities, E13), dst (eta_B terms from DST rates, E14), curves (joint "
-                      "fit to whole flow curves: phi, shear_rate, shear_stress)",
-                      o->kind));
-    }
-    if (o->kind != "curves") {
-      for (auto* opt : {phi, step}) {
-        if (opt->count() > 0)
-          throw InputError(
-              fmt::format("{}: only for --kind curves with instrument exports (not {})", opt->get_name(), o->kind));
-      }
-      if (o->files.size() != 1)
-        throw InputError(fmt::format("--data given {} times: --kind {} reads one CSV", o->files.size(), o->kind));
-    }
-    o->data = fmt::format("{}", fmt::join(o->files, ", "));
-    if (o->kind == "curves") {
-      if (terms->count() > 0) throw InputError(fmt::format("--terms = {}: only for --kind dst (not curves)", o->terms));
-      const bool default_base = o->params.preset.empty() && o->params.params.empty();
-      std::string note;
-      if (default_base) {
-        note =
-            fmt::format("no --preset or --params given: using the {} preset as the base parameter set", kDefaultPreset);
-        fmt::print(o->json ? stderr : stdout, "{}\n", note);
-      }
-      const rheology::Preset base = o->params.load(kDefaultPreset);
-      const FlowCurveData d = read_flow_curve_data(*cmd, data, step, o->files, o->steps, o->phi, o->json);
-      fit_curves_command({o->data, o->out, o->parameters, o->residual, o->png, o->json, o->strict, d.args}, d.table,
-                         base, note);
-      return;
-    }
-    for (auto* opt : {parameters, residual, strict}) {
-      if (opt->count() > 0)
-        throw InputError(fmt::format("{}: only for --kind curves (not {})", opt->get_name(), o->kind));
-    }
-    const rheology::FitKind kind = rheology::parse_fit_kind(o->kind, "--kind");
-    rheology::FitOptions options;
-    if (terms->count() > 0) {
-      if (kind != rheology::FitKind::dst) {
-        throw InputError(fmt::format("--terms = {}: only for --kind dst (not {})", o->terms, o->kind));
-      }
-      if (o->terms < 1) throw InputError(fmt::format("--terms = {}: must be >= 1", o->terms));
-      options.terms = o->terms;
-    }
-    const bool default_base = o->params.preset.empty() && o->params.params.empty();
-    rheology::Preset preset = o->params.load(kDefaultPreset);
-    std::string note;
-    if (default_base) {
-      note =
-          fmt::format("no --preset or --params given: using the {} preset as the base parameter set", kDefaultPreset);
-      fmt::print(o->json ? stderr : stdout, "{}\n", note);
-    }
-    const Data d = read_data(o->data, kind, preset.steady.eta_0);
-    options.where = o->data;
-    rheology::validate_fit_data(kind, d.phi, d.values, preset.steady, options);
-    io::check_writable(o->out, "--out");
-    if (!o->png.empty()) io::check_writable(o->png, "--plot");
-
-    const rheology::FitResult r = rheology::fit(kind, d.phi, d.values, preset.steady, options);
-
-    const std::string base_desc = fmt::format("{} ({})", preset.name, preset.file);
-    rheology::Preset fitted = preset;
-    fitted.steady = r.params;
-    fitted.name = sanitize(fs::path(o->out).stem().string());
-    fitted.source = sanitize(fmt::format("oobleck rheology fit --kind {} to {}; base {}: {}", o->kind,
-                                         fs::path(o->data).filename().string(), preset.name, preset.source));
-    try {
-      rheology::validate(fitted, o->out);
-    } catch (const InputError& e) {
-      throw NumericalError(fmt::format("the fitted parameters break a rule: {}", e.what()));
-    }
-
-    std::string tmp_png;
-    if (!o->png.empty()) {
-      tmp_png = plot_fit(
-          r, d, fmt::format("{}: fit --kind {} (base {})", fs::path(o->data).filename().string(), o->kind, preset.name),
-          o->png);
-    }
-    try {
-      io::write_file_atomically(o->out, toml_header(r, o->data, base_desc) + rheology::to_toml(fitted), "--out");
-    } catch (...) {
-      if (!tmp_png.empty()) {
-        std::error_code ec;
-        fs::remove(tmp_png, ec);
-      }
-      throw;
-    }
-    if (!tmp_png.empty()) fs::rename(tmp_png, o->png);
-
-    std::string warning;
-    if (r.rms > 0.1) {
-      const std::string hint =
-          kind == rheology::FitKind::dst
-              ? fmt::format(
-                    "check the units (shear_rate_dst in 1/s), the base set (phi_c, phi_j, tau_star, eta_0 = "
-                    "{} Pa s) and the number of eta_B terms (--terms)",
-                    preset.steady.eta_0)
-              : fmt::format(
-                    "check the units (viscosity in Pa s, eta_0 = {} Pa s of the base set) and that the "
-                    "points are {} viscosities",
-                    preset.steady.eta_0, kind == rheology::FitKind::low ? "minimum" : "plateau (maximum)");
-      warning = fmt::format(
-          "warning: rms log residual {:.3g} > 0.1 (more than 10 % scatter): the fitted {} "
-          "asymptote does not describe these data well; {}",
-          r.rms, rheology::to_string(kind), hint);
-    }
-    if (o->json) {
-      if (!warning.empty()) fmt::print(stderr, "{}\n", warning);
-      nlohmann::json params = nlohmann::json::object();
-      for (const auto& p : r.parameters) {
-        params[p.name] = {{"value", p.value},
-                          {"std_error", std::isfinite(p.std_error) ? nlohmann::json(p.std_error) : nlohmann::json()}};
-      }
-      nlohmann::json j = {{"kind", rheology::to_string(kind)}, {"parameters", params}, {"n", r.n},     {"rms", r.rms},
-                          {"iterations", r.iterations},        {"base", preset.name},  {"out", o->out}};
-      if (!note.empty()) j["note"] = note;
-      fmt::print("{}\n", j.dump());
-      return;
-    }
-    fmt::print("base parameter set: {} [{} units]; mu_c = {} (fixed)\n", base_desc, preset.units, preset.steady.mu_c);
-    fmt::print("fit --kind {} to {}: n = {} points, p = {} parameters; Ceres converged ({} iterations)\n", o->kind,
-               o->data, r.n, r.p, r.iterations);
-    std::size_t width = 0;
-    for (const auto& p : r.parameters) width = std::max(width, p.name.size());
-    for (const auto& p : r.parameters) {
-      const double rel = std::abs(p.std_error / p.value);
-      fmt::print("  {:<{}} = {:<12.6g} +- {:<10}  {:<11}{}\n", p.name, width, p.value, fmt_se(p.std_error),
-                 unit_of(p.name), std::isfinite(rel) ? fmt::format("({:.2g} %)", 100.0 * rel) : "");
-    }
-    if (!r.covariance_ok) {
-      fmt::print(
-          "  standard errors n/a: the parameters are not all identifiable from these data (rank-deficient "
-          "Jacobian){}\n",
-          kind == rheology::FitKind::dst ? "; fit fewer eta_B terms (--terms)" : "");
-    }
-    fmt::print("rms log residual = {:.4g} (n = {})\n", r.rms, r.n);
-    if (!warning.empty()) fmt::print("{}\n", warning);
-    fmt::print("wrote {}\n", o->out);
-    if (!o->png.empty()) fmt::print("wrote {}\n", o->png);
-  });
+  a->residual_opt = cmd->add_option("--residual", a->residual,
+                                    "curves only: rate (ln shear rate at the measured stress) or stress (ln shear "
+                                    "stress at the measured rate)");
+  a->strict_opt = cmd->add_flag("--strict", a->strict,
+                                "curves only: a parameter the data do not determine is an error (default: it is held "
+                                "at the base set's value, with a warning naming it)");
+  cmd->callback([a] { run_fit(*a); });
 }
 
 }  // namespace oobleck::cli
