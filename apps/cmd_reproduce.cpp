@@ -130,17 +130,19 @@ void verification(Reproduction& r) {
 
 std::string num_or_nan(const nlohmann::json& j, const char* key, const char* fmtspec = "{:.3g}");
 
-void annular(Reproduction& r) {
-  const std::string t = r.threads > 0 ? fmt::format(" --threads {}", r.threads) : "";
-  const std::string q = r.quick ? " --set grid.cell_size=0.002" : "";
-  r.oobleck(fmt::format("run {}/scenes/paper/annular_shear.toml --out {}/annular_fast --quiet{}{}", OOBLECK_SOURCE_DIR,
-                        r.out, t, q),
-            "S1 annular shear, u_i = 84 mm/s (Fig. 6)");
-  r.plot("plot_annular.py", {r.out + "/annular_fast", r.out + "/annular_fast.png"});
-  const auto s = r.summary("annular_fast");
-  // The band at the paper's last angle (0.31 rad), or the last profile of a shorter run: its
-  // rotation relative to the bob, v_theta/(omega_bob r) = (v/u_i) r_0/r, next to the bob and
-  // averaged over the band (from the bob out to where it first falls below 0.5, the front).
+/// The fast run's band at the paper's last angle (0.31 rad), or at the last profile of a shorter
+/// run: its rotation relative to the bob, v_theta/(omega_bob r) = (v/u_i) r_0/r, next to the bob and
+/// averaged over the band (from the bob out to where it first falls below 0.5, the front).
+struct AnnularBand {
+  double angle = NAN;        ///< of the profile [rad]
+  double next_to_bob = NAN;  ///< rotation one cell from the bob
+  double mean = NAN;         ///< rotation averaged over the band
+  double front = NAN;        ///< r where the rotation first falls below 0.5 [m]
+  double vmax = 0;           ///< largest v/u_i of the profile
+  double r_wall = NAN;       ///< the profile's last r, the outer wall [m]
+};
+
+AnnularBand annular_band(const nlohmann::json& s) {
   const auto& profiles = s["profiles"];
   std::size_t k31 = 0;
   for (std::size_t k = 0; k < profiles.size(); ++k)
@@ -148,41 +150,54 @@ void annular(Reproduction& r) {
   const auto& prof31 = profiles[k31];
   const auto pr = prof31["r"].get<std::vector<double>>();
   const auto pv = prof31["v_over_ui"].get<std::vector<double>>();
-  double vmax = 0, band_sum = 0, band_front = NAN, next_to_bob = NAN;
+  AnnularBand b;
+  b.angle = prof31["angle"].get<double>();
+  double band_sum = 0;
   std::size_t band_n = 0;
   for (std::size_t i = 0; i < pv.size(); ++i) {
-    vmax = std::max(vmax, pv[i]);
+    b.vmax = std::max(b.vmax, pv[i]);
     const double rot = pv[i] * pr.front() / pr[i];
-    if (i == 1) next_to_bob = rot;
-    if (i > 0 && std::isnan(band_front)) {
+    if (i == 1) b.next_to_bob = rot;
+    if (i > 0 && std::isnan(b.front)) {
       if (rot < 0.5) {
-        band_front = pr[i];
+        b.front = pr[i];
       } else {
         band_sum += rot;
         ++band_n;
       }
     }
   }
-  const double band_mean = band_n > 0 ? band_sum / static_cast<double>(band_n) : NAN;
+  b.mean = band_n > 0 ? band_sum / static_cast<double>(band_n) : NAN;
+  b.r_wall = pr.back();
+  return b;
+}
+
+/// S1 fast bob: the band's front moves at a near-constant speed, and the band rotates rigidly.
+void annular_band_claims(Reproduction& r, const nlohmann::json& s) {
+  const AnnularBand b = annular_band(s);
   const double front_r2 = s.contains("front_fit") ? s["front_fit"]["r_squared"].get<double>() : NAN;
   const double farthest = s.contains("front_farthest") ? s["front_farthest"].get<double>() : NAN;
   const double farthest_t = s.contains("front_farthest_time") ? s["front_farthest_time"].get<double>() : NAN;
-  const double r_wall = pr.back();
   r.claims.push_back(
       {"S1 fast bob: a band grows from the bob at a near-constant front speed (paper)", "front at near-constant speed",
        fmt::format("velocity front (v_theta/(omega_bob r) = 0.5) at {:.3g} m/s, R^2 {:.3f} (front_speed, "
                    "front_fit), up to r = {:.1f} mm at {:.3f} s (front_farthest); outer wall at {:.1f} mm",
                    s["front_speed"].is_null() ? NAN : s["front_speed"].get<double>(), front_r2, 1e3 * farthest,
-                   farthest_t, 1e3 * r_wall),
+                   farthest_t, 1e3 * b.r_wall),
        single_verdict(front_r2 >= 0.95, fmt::format("straight-line fit R^2 {:.3f} < 0.95", front_r2))});
   r.claims.push_back({"S1 fast bob: the band rotates rigidly with the bob (paper)",
                       "rigid band (v_theta/(omega_bob r) = 1)",
                       fmt::format("at {:.2f} rad (profiles): v_theta/(omega_bob r) {:.2f} one cell from the bob, "
                                   "{:.2f} on average over the band (to its front at r = {:.1f} mm); max v/u_i {:.2f}",
-                                  prof31["angle"].get<double>(), next_to_bob, band_mean, 1e3 * band_front, vmax),
-                      single_verdict(band_mean >= 0.9,
+                                  b.angle, b.next_to_bob, b.mean, 1e3 * b.front, b.vmax),
+                      single_verdict(b.mean >= 0.9,
                                      "the band co-rotates but is not rigid (mean v_theta/(omega_bob r) "
                                      "over the band < 0.9)")});
+}
+
+/// S1 fast bob: all flow stops when the band reaches the outer wall (paper), and how far the
+/// jammed structure spreads (oobleck's own measure).
+void annular_arrest_claims(Reproduction& r, const nlohmann::json& s) {
   // "All flow stops when it reaches the outer wall": the velocity band at the wall
   // (flow_stop_time), and the outer half's rotation after its peak (outer_arrest).
   const auto& arrest = s["outer_arrest"];
@@ -213,14 +228,18 @@ void annular(Reproduction& r) {
            "structure front at the outer wall {} (structure_front_wall_time)",
            spans ? fmt::format("at {:.3f} s", s["structure_front_wall_time"].get<double>()) : std::string("never")),
        single_verdict(spans, "the structure front stays inside the gap")});
-  // Slow bob: 0.31 rad of rotation takes 4.6 s at 0.84 mm/s; --quick: 2 mm grid up to 0.1 rad.
+}
+
+/// S1 slow bob: the run, its plot, and its profiles against the Newtonian A r + B/r; returns its
+/// summary. 0.31 rad of rotation takes 4.6 s at 0.84 mm/s; --quick: 2 mm grid up to 0.1 rad.
+nlohmann::json annular_slow(Reproduction& r, const std::string& threads) {
   const std::string qs = r.quick ? " --set grid.cell_size=0.002 --set duration=1.55" : " --set duration=4.7";
   r.oobleck(
       fmt::format("run {}/scenes/paper/annular_shear.toml --out {}/annular_slow --quiet --set u_inner=0.00084{}{}",
-                  OOBLECK_SOURCE_DIR, r.out, t, qs),
+                  OOBLECK_SOURCE_DIR, r.out, threads, qs),
       "S1 annular shear, u_i = 0.84 mm/s (Fig. 6)");
   r.plot("plot_annular.py", {r.out + "/annular_slow", r.out + "/annular_slow.png"});
-  const auto slow = r.summary("annular_slow");
+  const nlohmann::json slow = r.summary("annular_slow");
   std::string dists;
   double worst = 0.0;
   for (std::size_t k = 0; k < slow["profiles"].size(); ++k) {
@@ -232,8 +251,12 @@ void annular(Reproduction& r) {
   r.claims.push_back({"S1 slow bob (0.84 mm/s): profile vs Newtonian A r + B/r (L2 distance of v/u_i)",
                       "approaches A r + B/r", dists,
                       single_verdict(worst < 0.05, fmt::format("distance {:.3f} >= 0.05 after 0 rad", worst))});
-  // Why the two bob speeds differ, from the steady model alone (docs/analysis.md, steady_flow):
-  // a calculation on the bed's parameters, not a measurement of the runs.
+  return slow;
+}
+
+/// Why the two bob speeds differ, from the steady model alone (docs/analysis.md, steady_flow): a
+/// calculation on the bed's parameters, not a measurement of the runs.
+void annular_steady_flow(Reproduction& r, const nlohmann::json& s, const nlohmann::json& slow) {
   const nlohmann::json none = nlohmann::json::object();
   const auto& sf = s.contains("steady_flow") ? s["steady_flow"] : none;
   const auto& sfs = slow.contains("steady_flow") ? slow["steady_flow"] : none;
@@ -253,6 +276,22 @@ void annular(Reproduction& r) {
                    num_or_nan(sf, "max_shear_rate"), num_or_nan(sf, "shear_rate_dst"), mm(sf, "bob_speed_limit"),
                    mm(sf, "bob_speed_bound"), possible(sf), possible(sfs)),
        "model prediction, consistent with the runs above (not a measurement)"});
+}
+
+/// S1 annular shear (Fig. 6): the fast bob's band and arrest, the slow bob's Newtonian-like
+/// profiles, and the steady model's account of the difference.
+void annular(Reproduction& r) {
+  const std::string t = r.threads > 0 ? fmt::format(" --threads {}", r.threads) : "";
+  const std::string q = r.quick ? " --set grid.cell_size=0.002" : "";
+  r.oobleck(fmt::format("run {}/scenes/paper/annular_shear.toml --out {}/annular_fast --quiet{}{}", OOBLECK_SOURCE_DIR,
+                        r.out, t, q),
+            "S1 annular shear, u_i = 84 mm/s (Fig. 6)");
+  r.plot("plot_annular.py", {r.out + "/annular_fast", r.out + "/annular_fast.png"});
+  const auto s = r.summary("annular_fast");
+  annular_band_claims(r, s);
+  annular_arrest_claims(r, s);
+  const auto slow = annular_slow(r, t);
+  annular_steady_flow(r, s, slow);
 }
 
 std::string num_or_nan(const nlohmann::json& j, const char* key, const char* fmtspec) {
