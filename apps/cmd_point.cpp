@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <initializer_list>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -85,10 +86,8 @@ std::string csv_head(std::initializer_list<CsvColumn> columns, const rheology::P
   return fmt::format("# units: {}\n{}\n", fmt::join(units, ", "), fmt::join(names, ","));
 }
 
-void check_phi(double phi) {
-  if (!(std::isfinite(phi) && phi > 0.0 && phi < 1.0))
-    throw InputError(fmt::format("--phi = {}: must lie in (0, 1)", phi));
-}
+/// An option left at NaN (not given) as an empty optional.
+std::optional<double> given(double v) { return std::isnan(v) ? std::nullopt : std::optional<double>(v); }
 
 /// Progress line on stderr at most once per second.
 class ProgressPrinter {
@@ -137,38 +136,22 @@ void shear_command(CLI::App& point) {
   cmd->callback([o] {
     rheology::Preset p = o->params.load();
     o->mat.apply(p);
-    check_phi(o->phi);
-    const bool by_stress = !std::isnan(o->stress);
-    if (std::isnan(o->rate) && !by_stress) throw InputError("one of --shear-rate R or --shear-stress S is required");
-    if (!by_stress && !(std::isfinite(o->rate) && o->rate > 0.0))
-      throw InputError(fmt::format("--shear-rate = {}: must be positive [1/s]", o->rate));
-    if (by_stress && !(std::isfinite(o->stress) && o->stress > 0.0))
-      throw InputError(fmt::format("--shear-stress = {}: must be positive [Pa]", o->stress));
-    if (!(std::isfinite(o->duration) && o->duration > 0.0))
-      throw InputError(fmt::format("--duration = {}: must be positive [s]", o->duration));
-    if (!std::isnan(o->dt) && !(std::isfinite(o->dt) && o->dt > 0.0 && o->dt <= o->duration))
-      throw InputError(fmt::format("--dt = {}: must lie in (0, --duration = {}] [s]", o->dt, o->duration));
-    if (!(o->f0 >= 0.0 && o->f0 <= 1.0)) throw InputError(fmt::format("--f0 = {}: must lie in [0, 1]", o->f0));
-    if (o->samples < 2) throw InputError(fmt::format("--samples = {}: must be >= 2", o->samples));
+    material::ShearInput in;
+    in.phi = o->phi;
+    in.shear_rate = given(o->rate);
+    in.shear_stress = given(o->stress);
+    in.duration = o->duration;
+    in.dt = given(o->dt);
+    in.f0 = o->f0;
+    in.samples = o->samples;
+    material::validate(in, material::ArgStyle::cli);
     io::check_writable(o->out, "--out");
     if (!o->png.empty()) io::check_writable(o->png, "--plot");
+    const bool by_stress = in.shear_stress.has_value();
 
     const material::GranularLaw law(p);
-    material::ShearOptions so;
-    so.phi = o->phi;
-    so.stress_controlled = by_stress;
-    so.shear_rate = by_stress ? 0.0 : o->rate;
-    so.shear_stress = by_stress ? o->stress : 0.0;
-    so.duration = o->duration;
-    so.dt = std::isnan(o->dt) ? 0.0 : o->dt;
-    so.f0 = o->f0;
-    so.samples = o->samples;
-    if (so.dt <= 0.0) {
-      const double rate_scale =
-          by_stress
-              ? o->stress / (p.steady.eta_0 * rheology::eta_r_low(p.steady, std::min(o->phi, 0.999 * p.steady.phi_j)))
-              : o->rate;
-      so.dt = material::default_dt(law, o->phi, rate_scale, o->duration);
+    const material::ShearOptions so = material::shear_options(law, in);
+    if (!in.dt) {
       fmt::print("dt = {:.4g} s (default{})\n", so.dt,
                  so.dt <= o->duration / 2e7 * (1.0 + 1e-12) ? "; floored at duration/2e7: eta/G is not resolved" : "");
     }
@@ -248,54 +231,32 @@ void relax_command(CLI::App& point) {
   cmd->callback([o] {
     rheology::Preset base = o->params.load();
     o->mat.apply(base);
-    check_phi(o->phi);
-    rheology::validate_phi(base.steady, o->phi, "--phi");
-    const bool by_stress = !std::isnan(o->stress);
-    if (std::isnan(o->rate) && !by_stress) throw InputError("one of --shear-rate R or --shear-stress S is required");
-    if (!by_stress && !(std::isfinite(o->rate) && o->rate > 0.0))
-      throw InputError(fmt::format("--shear-rate = {}: must be positive [1/s]", o->rate));
-    if (by_stress && !(std::isfinite(o->stress) && o->stress > 0.0))
-      throw InputError(fmt::format("--shear-stress = {}: must be positive [Pa]", o->stress));
-    if (!(std::isfinite(o->duration) && o->duration > 0.0))
-      throw InputError(fmt::format("--duration = {}: must be positive [s]", o->duration));
-    if (!std::isnan(o->dt) && !(std::isfinite(o->dt) && o->dt > 0.0 && o->dt <= o->duration))
-      throw InputError(fmt::format("--dt = {}: must lie in (0, --duration = {}] [s]", o->dt, o->duration));
-    if (o->samples < 2) throw InputError(fmt::format("--samples = {}: must be >= 2", o->samples));
-    for (double g : o->G)
-      if (!(std::isfinite(g) && g > 0.0)) throw InputError(fmt::format("--G = {}: must be positive [Pa]", g));
-    for (double k : o->K0)
-      if (!(std::isfinite(k) && k > 0.0)) throw InputError(fmt::format("--K0 = {}: must be positive", k));
-    if (by_stress) (void)material::steady_rate_at_stress(base.steady, o->phi, o->stress);  // range check
+    material::RelaxInput in;
+    in.phi = o->phi;
+    in.shear_rate = given(o->rate);
+    in.shear_stress = given(o->stress);
+    in.duration = o->duration;
+    in.dt = given(o->dt);
+    in.samples = o->samples;
+    in.G = o->G;
+    in.K_0 = o->K0;
+    material::validate(in, base.steady, material::ArgStyle::cli);
     io::check_writable(o->out, "--out");
     if (!o->png.empty()) io::check_writable(o->png, "--plot");
-    std::vector<double> Gs = o->G.empty() ? std::vector<double>{base.granular.G} : o->G;
-    std::vector<double> K0s = o->K0.empty() ? std::vector<double>{base.granular.K_0} : o->K0;
+    const bool by_stress = in.shear_stress.has_value();
 
-    std::vector<material::RelaxResult> results;
-    for (double K0 : K0s) {
-      for (double G : Gs) {
-        rheology::Preset p = base;
-        p.granular.G = G;
-        p.granular.K_0 = K0;
-        const material::GranularLaw law(p);
-        material::RelaxOptions ro;
-        ro.phi = o->phi;
-        ro.stress_controlled = by_stress;
-        ro.shear_rate = by_stress ? 0.0 : o->rate;
-        ro.shear_stress = by_stress ? o->stress : 0.0;
-        ro.duration = o->duration;
-        ro.dt = std::isnan(o->dt) ? 0.0 : o->dt;
-        ro.samples = o->samples;
-        ProgressPrinter progress(fmt::format("point relax G = {:g} Pa, K_0 = {:g}", G, K0));
-        results.push_back(material::run_relax(law, ro, std::ref(progress)));
-        const auto& rr = results.back();
-        fmt::print(
-            "G = {:g} Pa, K_0 = {:g}: steady tau_bar_0 = {:.6g} Pa, p_0 = {:.6g} Pa, f_0 = {:.6g} after {:.4g} "
-            "strain; initial relaxation time c(f_0) eta_0/G = {:.4g} s; tau_bar(end)/tau_bar_0 = {:.4g}\n",
-            G, K0, rr.tau_bar_0, rr.p_0, rr.f_0, rr.preshear_strain, rr.relaxation_time_0,
-            rr.samples.back().tau_bar / rr.tau_bar_0);
-      }
-    }
+    material::RelaxSweepHooks hooks;
+    hooks.start = [](const material::RelaxCase& c) -> material::Progress {
+      return ProgressPrinter(fmt::format("point relax G = {:g} Pa, K_0 = {:g}", c.G, c.K_0));
+    };
+    hooks.done = [](const material::RelaxCase& c, const material::RelaxResult& rr) {
+      fmt::print(
+          "G = {:g} Pa, K_0 = {:g}: steady tau_bar_0 = {:.6g} Pa, p_0 = {:.6g} Pa, f_0 = {:.6g} after {:.4g} "
+          "strain; initial relaxation time c(f_0) eta_0/G = {:.4g} s; tau_bar(end)/tau_bar_0 = {:.4g}\n",
+          c.G, c.K_0, rr.tau_bar_0, rr.p_0, rr.f_0, rr.preshear_strain, rr.relaxation_time_0,
+          rr.samples.back().tau_bar / rr.tau_bar_0);
+    };
+    const std::vector<material::RelaxResult> results = material::run_relax_sweep(base, in, hooks);
     io::OutputFile csv(o->out, "--out");
     auto& st = csv.stream();
     st << csv_head({{"case", "1"},

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <initializer_list>
 #include <sstream>
 
 #include <unistd.h>
@@ -58,19 +59,91 @@ std::string flow_curve_units(const rheology::Preset& p) {
       rate, stress, visc, p.name, p.units);
 }
 
+/// The volume fractions of measured flow curves (--data), sorted and distinct; InputError if a
+/// column is missing or a rate or stress is not positive.
+std::vector<double> measured_phis(const io::CsvTable& t) {
+  for (const char* c : {"phi", "shear_rate", "shear_stress"}) {
+    if (!t.has_column(c)) {
+      throw InputError(
+          fmt::format("{}: missing column '{}' (columns present: {}); --data needs phi,shear_rate,shear_stress (or an "
+                      "instrument export with --phi)",
+                      t.file, c, fmt::join(t.header, ", ")));
+    }
+  }
+  std::vector<double> phis = t.column("phi");
+  const std::vector<double> rate = t.column("shear_rate"), stress = t.column("shear_stress");
+  for (std::size_t k = 0; k < phis.size(); ++k) {
+    if (!(rate[k] > 0.0 && stress[k] > 0.0 && std::isfinite(rate[k]) && std::isfinite(stress[k]))) {
+      throw InputError(fmt::format("{}: data row {}: shear_rate = {}, shear_stress = {}: must be positive", t.file,
+                                   k + 1, rate[k], stress[k]));
+    }
+  }
+  std::sort(phis.begin(), phis.end());
+  phis.erase(std::unique(phis.begin(), phis.end()), phis.end());
+  return phis;
+}
+
+/// The flow-curve CSV (rheology::flow_curve_columns, E11 and E14) at each phi; `what` names the
+/// file in messages.
+void write_flow_curves(const std::string& path, const std::string& what, const rheology::Preset& p,
+                       const std::vector<double>& phis, int points) {
+  const std::vector<double> c = rheology::flow_curve_columns(p.steady, phis, points);
+  const std::size_t rows = c.size() / rheology::kFlowCurveColumns.size();
+  io::OutputFile csv(path, what);
+  auto& s = csv.stream();
+  s << flow_curve_units(p);
+  s << fmt::format("{}\n", fmt::join(rheology::kFlowCurveColumns, ","));
+  for (std::size_t i = 0; i < rows; ++i) {
+    s << fmt::format("{},{},{},{},{},{},{},{},{}\n", num(c[i]), num(c[rows + i]), num(c[2 * rows + i]),
+                     num(c[3 * rows + i]), num(c[4 * rows + i]), num(c[5 * rows + i]), num(c[6 * rows + i]),
+                     num(c[7 * rows + i]), num(c[8 * rows + i]));
+  }
+  csv.commit();
+}
+
+/// The measured points of --data as the plot script's data CSV.
+void write_plot_data(const std::string& path, const io::CsvTable& t) {
+  const std::vector<double> phi = t.column("phi"), rate = t.column("shear_rate"), stress = t.column("shear_stress");
+  std::string d = "# units: phi=1, shear_rate=1/s, shear_stress=Pa; measured: " + t.file + "\n";
+  d += "phi,shear_rate,shear_stress\n";
+  for (std::size_t k = 0; k < phi.size(); ++k)
+    d += fmt::format("{},{},{}\n", num(phi[k]), num(rate[k]), num(stress[k]));
+  io::write_file_atomically(path, d, "plot data");
+}
+
+/// The options of `rheology flow-curve`.
+struct FlowCurveOpts {
+  ParamsOption params;
+  std::vector<double> phi;
+  int points = 400;
+  std::string out, png, x = "rate", y = "stress", xlim, ylim;
+  std::vector<std::string> files, steps;
+};
+
+/// The usage rules of `rheology flow-curve` (CLI::ValidationError, exit 1): something to write,
+/// the options in `draw_only` only with --plot, distinct axes, --step only with --data.
+void check_flow_curve_usage(const FlowCurveOpts& o, std::initializer_list<const CLI::Option*> draw_only,
+                            const CLI::Option* data, const CLI::Option* step) {
+  if (o.out.empty() && o.png.empty()) {
+    throw CLI::ValidationError("--out/--plot", "give --out CSV, --plot PNG or both (nothing to write)");
+  }
+  if (o.png.empty()) {
+    for (const CLI::Option* opt : draw_only) {
+      if (opt->count() > 0) throw CLI::ValidationError(opt->get_name(), "draws on the plot: give --plot PNG");
+    }
+  }
+  if (o.x == "stress" && o.y == "stress") {
+    throw CLI::ValidationError("--x", "--x stress with --y stress draws the stress against itself: use --y viscosity");
+  }
+  if (step->count() > 0 && data->count() == 0) throw CLI::ValidationError("--step", "only with --data");
+}
+
 void flow_curve_command(CLI::App& rheology) {
   auto* cmd = rheology.add_subcommand(
       "flow-curve",
       "steady flow curves tau(gamma_dot) with every branch (E11), written as CSV and/or plotted, optionally "
       "over measured data (--data)");
-  struct Opts {
-    ParamsOption params;
-    std::vector<double> phi;
-    int points = 400;
-    std::string out, png, x = "rate", y = "stress", xlim, ylim;
-    std::vector<std::string> files, steps;
-  };
-  auto o = std::make_shared<Opts>();
+  auto o = std::make_shared<FlowCurveOpts>();
   o->params.add_to(cmd);
   cmd->add_option("--phi", o->phi,
                   "volume fraction(s), 0 < phi < phi_j (repeat for several); with --data: the volume fraction of "
@@ -98,19 +171,7 @@ void flow_curve_command(CLI::App& rheology) {
   auto* ylim = cmd->add_option("--ylim", o->ylim, "plot's vertical range LO,HI (default: as --xlim)");
   cmd->callback([o, cmd, data, step, x, y, xlim, ylim] {
     // Usage first (exit 1): what to write, and options that only draw.
-    if (o->out.empty() && o->png.empty()) {
-      throw CLI::ValidationError("--out/--plot", "give --out CSV, --plot PNG or both (nothing to write)");
-    }
-    if (o->png.empty()) {
-      for (const CLI::Option* opt : {data, step, x, y, xlim, ylim}) {
-        if (opt->count() > 0) throw CLI::ValidationError(opt->get_name(), "draws on the plot: give --plot PNG");
-      }
-    }
-    if (o->x == "stress" && o->y == "stress") {
-      throw CLI::ValidationError("--x",
-                                 "--x stress with --y stress draws the stress against itself: use --y viscosity");
-    }
-    if (step->count() > 0 && data->count() == 0) throw CLI::ValidationError("--step", "only with --data");
+    check_flow_curve_usage(*o, {data, step, x, y, xlim, ylim}, data, step);
     const std::string xl = o->xlim.empty() ? "" : parse_limits(o->xlim, "--xlim");
     const std::string yl = o->ylim.empty() ? "" : parse_limits(o->ylim, "--ylim");
     if (o->files.empty() && o->phi.empty()) {
@@ -123,25 +184,7 @@ void flow_curve_command(CLI::App& rheology) {
     std::vector<double> phis = o->phi;
     if (!o->files.empty()) {
       measured = read_flow_curve_data(*cmd, data, step, o->files, o->steps, o->phi, false);
-      const io::CsvTable& t = measured.table;
-      for (const char* c : {"phi", "shear_rate", "shear_stress"}) {
-        if (!t.has_column(c)) {
-          throw InputError(fmt::format(
-              "{}: missing column '{}' (columns present: {}); --data needs phi,shear_rate,shear_stress (or an "
-              "instrument export with --phi)",
-              t.file, c, fmt::join(t.header, ", ")));
-        }
-      }
-      phis = t.column("phi");
-      const std::vector<double> rate = t.column("shear_rate"), stress = t.column("shear_stress");
-      for (std::size_t k = 0; k < phis.size(); ++k) {
-        if (!(rate[k] > 0.0 && stress[k] > 0.0 && std::isfinite(rate[k]) && std::isfinite(stress[k]))) {
-          throw InputError(fmt::format("{}: data row {}: shear_rate = {}, shear_stress = {}: must be positive", t.file,
-                                       k + 1, rate[k], stress[k]));
-        }
-      }
-      std::sort(phis.begin(), phis.end());
-      phis.erase(std::unique(phis.begin(), phis.end()), phis.end());
+      phis = measured_phis(measured.table);
     }
     for (double phi : phis) {
       rheology::validate_phi(p.steady, phi, fmt::format("--phi (parameters: {})", p.file));
@@ -157,20 +200,7 @@ void flow_curve_command(CLI::App& rheology) {
     const std::string data_csv = (tmp_dir / (stem + "-data.csv")).string();
     TempFiles cleanup;
     if (o->out.empty()) cleanup.files.push_back(curves_csv);
-    io::OutputFile csv(curves_csv, o->out.empty() ? "plot curves" : "--out");
-    auto& s = csv.stream();
-    s << flow_curve_units(p);
-    s << "phi,f,shear_rate,shear_stress,granular_pressure,granular_shear_stress,viscosity,eta_r,shear_rate_dst\n";
-    for (double phi : phis) {
-      const auto dst = rheology::shear_rate_dst(p.steady, phi);
-      const std::string dst_s = dst ? num(*dst) : "nan";
-      for (const auto& pt : rheology::flow_curve(p.steady, phi, o->points)) {
-        s << fmt::format("{},{},{},{},{},{},{},{},{}\n", num(pt.phi), num(pt.f), num(pt.shear_rate),
-                         num(pt.shear_stress), num(pt.granular_pressure), num(pt.granular_shear_stress),
-                         num(pt.viscosity), num(pt.eta_r), dst_s);
-      }
-    }
-    csv.commit();
+    write_flow_curves(curves_csv, o->out.empty() ? "plot curves" : "--out", p, phis, o->points);
     if (!o->out.empty()) {
       fmt::print("wrote {} ({} curves x {} points; parameters {} [{} units])\n", o->out, phis.size(), o->points, p.name,
                  p.units);
@@ -182,17 +212,11 @@ void flow_curve_command(CLI::App& rheology) {
       if (!xl.empty()) args.insert(args.end(), {"--xlim", xl});
       if (!yl.empty()) args.insert(args.end(), {"--ylim", yl});
       if (!o->files.empty()) {
-        const io::CsvTable& t = measured.table;
-        const std::vector<double> phi = t.column("phi"), rate = t.column("shear_rate"),
-                                  stress = t.column("shear_stress");
-        std::string d = "# units: phi=1, shear_rate=1/s, shear_stress=Pa; measured: " + t.file + "\n";
-        d += "phi,shear_rate,shear_stress\n";
-        for (std::size_t k = 0; k < phi.size(); ++k)
-          d += fmt::format("{},{},{}\n", num(phi[k]), num(rate[k]), num(stress[k]));
         cleanup.files.push_back(data_csv);
-        io::write_file_atomically(data_csv, d, "plot data");
-        args.insert(args.end(), {"--data", data_csv, "--data-label", t.file});
-        fmt::print("data: {}: {} points at phi = {}\n", t.file, phi.size(), fmt::join(phis, ", "));
+        write_plot_data(data_csv, measured.table);
+        args.insert(args.end(), {"--data", data_csv, "--data-label", measured.table.file});
+        fmt::print("data: {}: {} points at phi = {}\n", measured.table.file, measured.table.rows.size(),
+                   fmt::join(phis, ", "));
       }
       plot("plot_flow_curves.py", args, o->png);
       fmt::print("wrote {}\n", o->png);

@@ -1,9 +1,10 @@
 // Benchmark (not a test): steady flow-curve generation (E11 sweep) per preset, and the
 // xi_dot_eps > 0 variant that needs a scalar root per point. Reports points per second.
 // BM_FlowCurveColumns does, in C++, the work of the Python module's flow_curve (python/src/
-// module.cpp) besides the sweep: the DST rate (E14) and the 9 columns filled into one block; it
-// splits the Python overhead of bench/flow_curve_python.py into this work and the Python boundary.
-#include <optional>
+// bind_rheology.cpp): rheology::flow_curve_columns, the sweep with the DST rate (E14) and the 9
+// columns filled into one block; it splits the Python overhead of bench/flow_curve_python.py into
+// this work and the Python boundary.
+#include <span>
 #include <vector>
 
 #include <benchmark/benchmark.h>
@@ -31,20 +32,7 @@ static void BM_FlowCurveColumns(benchmark::State& state, const char* preset, dou
   const auto r = static_cast<std::size_t>(n);
   for (auto _ : state) {
     std::vector<double> c(9 * r);  // the module allocates a fresh (9, rows) array per call
-    const double dst = rheology::shear_rate_dst(p.steady, phi).value_or(-1.0);
-    std::size_t i = 0;
-    for (const auto& pt : rheology::flow_curve(p.steady, phi, n)) {
-      c[i] = pt.phi;
-      c[r + i] = pt.f;
-      c[2 * r + i] = pt.shear_rate;
-      c[3 * r + i] = pt.shear_stress;
-      c[4 * r + i] = pt.granular_pressure;
-      c[5 * r + i] = pt.granular_shear_stress;
-      c[6 * r + i] = pt.viscosity;
-      c[7 * r + i] = pt.eta_r;
-      c[8 * r + i] = dst;
-      ++i;
-    }
+    rheology::flow_curve_columns(p.steady, std::span<const double>(&phi, 1), n, c);
     benchmark::DoNotOptimize(c.data());
     benchmark::ClobberMemory();
   }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include <fmt/format.h>
 
@@ -114,14 +115,19 @@ double stress_controlled_step(const GranularLaw& law, GranularState& state, doub
   return rate;
 }
 
-ShearResult run_shear(const GranularLaw& law, const ShearOptions& o, const Progress& progress) {
-  ShearResult r;
+double shear_dt(const GranularLaw& law, const ShearOptions& o) {
+  if (o.dt > 0.0) return o.dt;
   const double rate_scale =
       o.stress_controlled
           ? o.shear_stress /
                 (law.eta_0() * rheology::eta_r_low(law.steady(), std::min(o.phi, 0.999 * law.steady().phi_j)))
           : o.shear_rate;
-  r.dt = o.dt > 0.0 ? o.dt : default_dt(law, o.phi, rate_scale, o.duration);
+  return default_dt(law, o.phi, rate_scale, o.duration);
+}
+
+ShearResult run_shear(const GranularLaw& law, const ShearOptions& o, const Progress& progress) {
+  ShearResult r;
+  r.dt = shear_dt(law, o);
   const long n = std::max(1L, static_cast<long>(std::ceil(o.duration / r.dt - 1e-9)));
   r.steps = n;
   GranularState st;
@@ -240,11 +246,18 @@ double steady_rate_at_stress(const rheology::SteadyParams& s, double phi, double
   return at(0.5 * (lo + hi)).shear_rate;
 }
 
-RelaxResult run_relax(const GranularLaw& law, const RelaxOptions& o, const Progress& progress) {
-  RelaxResult r;
-  r.G = law.G();
-  r.K_0 = law.granular().K_0;
-  // ---- pre-shear to steady state with steps of 2% strain ----
+namespace {
+
+/// The steady state of the pre-shear of run_relax and the strain it took.
+struct Preshear {
+  GranularState state;
+  GranularUpdate update;
+  double strain = 0.0;
+};
+
+/// Pre-shear to steady state with steps of at most 2% strain; throws NumericalError if no steady
+/// state with granular stress is reached.
+Preshear preshear(const GranularLaw& law, const RelaxOptions& o) {
   GranularState st;
   Eigen::Matrix3d D, W;
   simple_shear_rates(o.shear_rate, D, W);
@@ -298,7 +311,19 @@ RelaxResult run_relax(const GranularLaw& law, const RelaxOptions& o, const Progr
                     "tau_bar = {} Pa) at phi = {}",
                     regime_name(u.regime), u.tau_bar, o.phi));
   }
-  r.preshear_strain = rate_est * dt_pre * static_cast<double>(k + 1);
+  return {st, u, rate_est * dt_pre * static_cast<double>(k + 1)};
+}
+
+}  // namespace
+
+RelaxResult run_relax(const GranularLaw& law, const RelaxOptions& o, const Progress& progress) {
+  RelaxResult r;
+  r.G = law.G();
+  r.K_0 = law.granular().K_0;
+  const Preshear pre = preshear(law, o);
+  GranularState st = pre.state;
+  const GranularUpdate& u = pre.update;
+  r.preshear_strain = pre.strain;
   r.tau_bar_0 = u.tau_bar;
   r.f_0 = st.f;
   r.p_0 = u.p;
@@ -350,6 +375,119 @@ RelaxResult run_relax(const GranularLaw& law, const RelaxOptions& o, const Progr
     }
   }
   return r;
+}
+
+namespace {
+
+/// An argument's name as `style` spells it: the CLI option ("--shear-rate") or the Python keyword ("shear_rate").
+std::string arg(ArgStyle style, std::string name) {
+  if (style == ArgStyle::python) return name;
+  std::replace(name.begin(), name.end(), '_', '-');
+  return "--" + name;
+}
+
+void check_phi(double phi, ArgStyle style) {
+  if (!(std::isfinite(phi) && phi > 0.0 && phi < 1.0))
+    throw InputError(fmt::format("{} = {}: must lie in (0, 1)", arg(style, "phi"), phi));
+}
+
+/// The checks shared by the shear and relax inputs: the control (one of shear rate and shear
+/// stress, positive), duration and dt.
+void check_control_and_time(const std::optional<double>& rate, const std::optional<double>& stress, double duration,
+                            const std::optional<double>& dt, ArgStyle style) {
+  if (rate && stress)
+    throw InputError(
+        fmt::format("{} and {}: give one of them, not both", arg(style, "shear_rate"), arg(style, "shear_stress")));
+  if (!rate && !stress) {
+    throw InputError(style == ArgStyle::cli ? "one of --shear-rate R or --shear-stress S is required"
+                                            : "one of shear_rate or shear_stress is required");
+  }
+  if (rate && !(std::isfinite(*rate) && *rate > 0.0))
+    throw InputError(fmt::format("{} = {}: must be positive [1/s]", arg(style, "shear_rate"), *rate));
+  if (stress && !(std::isfinite(*stress) && *stress > 0.0))
+    throw InputError(fmt::format("{} = {}: must be positive [Pa]", arg(style, "shear_stress"), *stress));
+  if (!(std::isfinite(duration) && duration > 0.0))
+    throw InputError(fmt::format("{} = {}: must be positive [s]", arg(style, "duration"), duration));
+  if (dt && !(std::isfinite(*dt) && *dt > 0.0 && *dt <= duration)) {
+    throw InputError(
+        fmt::format("{} = {}: must lie in (0, {} = {}] [s]", arg(style, "dt"), *dt, arg(style, "duration"), duration));
+  }
+}
+
+void check_samples(int samples, ArgStyle style) {
+  if (samples < 2) throw InputError(fmt::format("{} = {}: must be >= 2", arg(style, "samples"), samples));
+}
+
+}  // namespace
+
+void validate(const ShearInput& in, ArgStyle style) {
+  check_phi(in.phi, style);
+  check_control_and_time(in.shear_rate, in.shear_stress, in.duration, in.dt, style);
+  if (!(in.f0 >= 0.0 && in.f0 <= 1.0))
+    throw InputError(fmt::format("{} = {}: must lie in [0, 1]", arg(style, "f0"), in.f0));
+  check_samples(in.samples, style);
+}
+
+ShearOptions shear_options(const GranularLaw& law, const ShearInput& in) {
+  ShearOptions so;
+  so.phi = in.phi;
+  so.stress_controlled = in.shear_stress.has_value();
+  so.shear_rate = so.stress_controlled ? 0.0 : in.shear_rate.value_or(0.0);
+  so.shear_stress = in.shear_stress.value_or(0.0);
+  so.duration = in.duration;
+  so.dt = in.dt.value_or(0.0);
+  so.f0 = in.f0;
+  so.samples = in.samples;
+  so.dt = shear_dt(law, so);
+  return so;
+}
+
+void validate(const RelaxInput& in, const rheology::SteadyParams& steady, ArgStyle style) {
+  check_phi(in.phi, style);
+  rheology::validate_phi(steady, in.phi, arg(style, "phi"));
+  check_control_and_time(in.shear_rate, in.shear_stress, in.duration, in.dt, style);
+  check_samples(in.samples, style);
+  for (double g : in.G) {
+    if (!(std::isfinite(g) && g > 0.0))
+      throw InputError(fmt::format("{} = {}: must be positive [Pa]", arg(style, "G"), g));
+  }
+  for (double k : in.K_0) {
+    if (!(std::isfinite(k) && k > 0.0)) throw InputError(fmt::format("{} = {}: must be positive", arg(style, "K0"), k));
+  }
+  if (in.shear_stress) (void)steady_rate_at_stress(steady, in.phi, *in.shear_stress);  // range check
+}
+
+RelaxOptions relax_options(const RelaxInput& in) {
+  RelaxOptions ro;
+  ro.phi = in.phi;
+  ro.stress_controlled = in.shear_stress.has_value();
+  ro.shear_rate = ro.stress_controlled ? 0.0 : in.shear_rate.value_or(0.0);
+  ro.shear_stress = in.shear_stress.value_or(0.0);
+  ro.duration = in.duration;
+  ro.dt = in.dt.value_or(0.0);
+  ro.samples = in.samples;
+  return ro;
+}
+
+std::vector<RelaxResult> run_relax_sweep(const rheology::Preset& base, const RelaxInput& in,
+                                         const RelaxSweepHooks& hooks) {
+  const std::vector<double> Gs = in.G.empty() ? std::vector<double>{base.granular.G} : in.G;
+  const std::vector<double> K0s = in.K_0.empty() ? std::vector<double>{base.granular.K_0} : in.K_0;
+  const RelaxOptions ro = relax_options(in);
+  std::vector<RelaxResult> results;
+  results.reserve(Gs.size() * K0s.size());
+  for (double K0 : K0s) {
+    for (double G : Gs) {
+      rheology::Preset p = base;
+      p.granular.G = G;
+      p.granular.K_0 = K0;
+      const GranularLaw law(p);
+      const RelaxCase c{G, K0};
+      results.push_back(run_relax(law, ro, hooks.start ? hooks.start(c) : Progress{}));
+      if (hooks.done) hooks.done(c, results.back());
+    }
+  }
+  return results;
 }
 
 }  // namespace oobleck::material

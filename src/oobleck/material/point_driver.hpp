@@ -1,8 +1,11 @@
 #pragma once
 // Homogeneous material-point experiments with the granular law (E16–E24, docs/equations.md): simple shear at
 // fixed volume, rate- or stress-controlled, and stress relaxation after cessation of steady shear
-// (the SI's method for G and K_0) beside the SI's reduced ODE. Used by `oobleck point` and tests.
+// (the SI's method for G and K_0) beside the SI's reduced ODE, with the input checks and the
+// relaxation sweep over G and K_0 that `oobleck point` and oobleck.point_shear/point_relax share.
+#include <cmath>
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "oobleck/material/granular.hpp"
@@ -56,6 +59,10 @@ void simple_shear_rates(double gamma_dot, Eigen::Matrix3d& D, Eigen::Matrix3d& W
 /// duration/1000 and at least duration/2e7 (a floor that is reported by the CLI).
 double default_dt(const GranularLaw& law, double phi, double shear_rate_scale, double duration);
 
+/// The time step of a shear run: o.dt if positive, else default_dt at the run's shear-rate scale
+/// (the imposed rate, or the imposed stress over the E12 viscosity eta_0 eta_r_low).
+double shear_dt(const GranularLaw& law, const ShearOptions& o);
+
 /// Run the shear experiment; throws NumericalError (describe()) if the law fails at any step.
 ShearResult run_shear(const GranularLaw& law, const ShearOptions& o, const Progress& progress = {});
 
@@ -99,6 +106,64 @@ double steady_rate_at_stress(const rheology::SteadyParams& s, double phi, double
 /// Pre-shear to steady state (coarse steps: the backward-Euler return map has the exact steady
 /// state for any dt), then D = W = 0. `law` carries G and K_0.
 RelaxResult run_relax(const GranularLaw& law, const RelaxOptions& o, const Progress& progress = {});
+
+/// How the input checks name the arguments in their messages: as the CLI's options
+/// ("--shear-rate") or as the Python module's keyword arguments ("shear_rate").
+enum class ArgStyle { cli, python };
+
+/// The inputs of a point shear run as a front end received them, before any check; an empty
+/// optional is an argument not given.
+struct ShearInput {
+  double phi = NAN;
+  std::optional<double> shear_rate, shear_stress;
+  double duration = NAN;
+  std::optional<double> dt;
+  double f0 = 0.0;
+  int samples = 1000;
+};
+
+/// Throws InputError naming the first bad argument and its rule (e.g. "--dt = 2: must lie in
+/// (0, --duration = 1] [s]"): 0 < phi < 1, exactly one of shear_rate and shear_stress, each
+/// positive, duration > 0, 0 < dt <= duration, 0 <= f0 <= 1, samples >= 2.
+void validate(const ShearInput& in, ArgStyle style);
+
+/// The run_shear options of a checked input, the time step resolved by shear_dt.
+ShearOptions shear_options(const GranularLaw& law, const ShearInput& in);
+
+/// The inputs of a relaxation sweep (one run_relax per pair of G and K_0) before any check.
+struct RelaxInput {
+  double phi = NAN;
+  std::optional<double> shear_rate, shear_stress;  ///< the pre-shear
+  double duration = NAN;
+  std::optional<double> dt;
+  int samples = 200;
+  std::vector<double> G, K_0;  ///< the sweep's moduli [Pa] and rate factors; empty: the parameter set's
+};
+
+/// Throws InputError naming the first bad argument and its rule: 0 < phi < 1 and phi < phi_j,
+/// the pre-shear as in validate(ShearInput), duration, dt and samples likewise, every G and K_0
+/// positive, and a pre-shear stress within the steady flow curve (steady_rate_at_stress).
+void validate(const RelaxInput& in, const rheology::SteadyParams& steady, ArgStyle style);
+
+/// The run_relax options of a checked input.
+RelaxOptions relax_options(const RelaxInput& in);
+
+/// One case of a relaxation sweep: the parameter set with these G and K_0.
+struct RelaxCase {
+  double G = 0.0, K_0 = 0.0;
+};
+
+/// Optional hooks of run_relax_sweep: `start` gives the progress callback of a case before it
+/// runs, `done` sees its result.
+struct RelaxSweepHooks {
+  std::function<Progress(const RelaxCase&)> start;
+  std::function<void(const RelaxCase&, const RelaxResult&)> done;
+};
+
+/// run_relax of a checked input for each K_0 (outer) and G (inner) of the sweep on `base`; the
+/// results in that order.
+std::vector<RelaxResult> run_relax_sweep(const rheology::Preset& base, const RelaxInput& in,
+                                         const RelaxSweepHooks& hooks = {});
 
 /// The SI's reduced relaxation ODE (docs/granular.md, "Notes on the SI"): d tau_bar/dt = -G gamma_dot^p,
 /// gamma_dot^p = tau_bar/(c(f) eta_0) with c(f) = mu_1 eta_n + (5/2) phi^2/(phi_m - phi) (E3–E5),

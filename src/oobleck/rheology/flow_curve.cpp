@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
@@ -171,6 +173,37 @@ std::optional<SteadyShearLimit> fastest_steady_shear(const SteadyParams& p, doub
   const double x = 0.5 * (lo + hi);
   const SteadyPoint s = steady_point(p, phi, fu / (1.0 + std::exp(-x)), fu / (1.0 + std::exp(x)));
   return SteadyShearLimit{s.shear_rate, s.shear_stress, s.f, true};
+}
+
+void flow_curve_columns(const SteadyParams& p, std::span<const double> phis, int points, std::span<double> out) {
+  const std::size_t rows = phis.size() * static_cast<std::size_t>(std::max(points, 2));
+  if (out.size() != kFlowCurveColumns.size() * rows) {
+    throw std::invalid_argument(fmt::format("flow_curve_columns: {} values for {} columns of {} rows", out.size(),
+                                            kFlowCurveColumns.size(), rows));
+  }
+  double* c = out.data();
+  std::size_t i = 0;
+  for (const double phi : phis) {
+    const double dst_rate = shear_rate_dst(p, phi).value_or(std::numeric_limits<double>::quiet_NaN());  // E14
+    for (const auto& pt : flow_curve(p, phi, points)) {
+      c[i] = pt.phi;
+      c[rows + i] = pt.f;
+      c[2 * rows + i] = pt.shear_rate;
+      c[3 * rows + i] = pt.shear_stress;
+      c[4 * rows + i] = pt.granular_pressure;
+      c[5 * rows + i] = pt.granular_shear_stress;
+      c[6 * rows + i] = pt.viscosity;
+      c[7 * rows + i] = pt.eta_r;
+      c[8 * rows + i] = dst_rate;
+      ++i;
+    }
+  }
+}
+
+std::vector<double> flow_curve_columns(const SteadyParams& p, std::span<const double> phis, int points) {
+  std::vector<double> out(kFlowCurveColumns.size() * phis.size() * static_cast<std::size_t>(std::max(points, 2)));
+  flow_curve_columns(p, phis, points, out);
+  return out;
 }
 
 }  // namespace oobleck::rheology

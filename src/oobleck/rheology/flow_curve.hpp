@@ -2,8 +2,11 @@
 // Steady simple-shear flow curves of the Baumgarten–Kamrin model, complete with every branch:
 // the curve is swept parametrically in the structure f (E11, docs/equations.md), so S-shaped and DST
 // branches are never lost by a root finder in gamma_dot or tau. Asymptotes E12–E14.
+#include <array>
 #include <optional>
+#include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "oobleck/rheology/params.hpp"
@@ -36,6 +39,21 @@ SteadyPoint steady_point(const SteadyParams& p, double phi, double f, double gap
 /// The flow curve at phi: `points` states with f increasing from 1e-10 f_u to f_u (1 - 1e-10),
 /// clustered logistically at both ends so the asymptotes are resolved.
 std::vector<SteadyPoint> flow_curve(const SteadyParams& p, double phi, int points = 400);
+
+/// The columns of a flow-curve table, in order: `oobleck rheology flow-curve`'s CSV and
+/// oobleck.flow_curve. shear_rate_dst is E14 at the row's phi (NaN where DST does not apply).
+inline constexpr std::array<std::string_view, 9> kFlowCurveColumns = {
+    "phi",       "f",     "shear_rate",    "shear_stress", "granular_pressure", "granular_shear_stress",
+    "viscosity", "eta_r", "shear_rate_dst"};
+
+/// The flow curves at each of `phis` (flow_curve with `points` states, one curve after the other)
+/// as the kFlowCurveColumns, column-major: row i of column j at out[j * rows + i], rows =
+/// phis.size() * points (points < 2 taken as 2, as flow_curve). `out` must hold 9 * rows values
+/// (std::invalid_argument otherwise); each phi is checked by flow_curve (validate_phi).
+void flow_curve_columns(const SteadyParams& p, std::span<const double> phis, int points, std::span<double> out);
+
+/// The same columns in a new vector of 9 * phis.size() * points values.
+std::vector<double> flow_curve_columns(const SteadyParams& p, std::span<const double> phis, int points);
 
 /// E12: relative viscosity of the low-viscosity (f -> 0) branch.
 double eta_r_low(const SteadyParams& p, double phi);
