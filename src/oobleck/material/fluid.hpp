@@ -14,14 +14,12 @@
 #include <Eigen/Core>
 #include <cmath>
 
+#include "oobleck/rheology/params.hpp"
+
 namespace oobleck::material {
 
-/// Parameters of the fluid law, SI units.
-struct FluidParams {
-  double eta_0_Pa_s = 1e-3;      ///< [Pa s] fluid viscosity η_0
-  double kappa_Pa = 1e6;         ///< [Pa] fluid bulk modulus κ (E26; not given by the paper)
-  double rho_f0_kg_m3 = 1000.0;  ///< [kg/m^3] fluid rest density ρ_f0
-};
+/// Parameters of the fluid law, SI units (declared with the other material parameters).
+using FluidParams = rheology::FluidParams;
 
 /// Effective mixture viscosity seen by the fluid phase, η_0 (1 + 5φ/2) [Pa s] (E25).
 inline double fluid_effective_viscosity(double eta_0_Pa_s, double phi) { return eta_0_Pa_s * (1.0 + 2.5 * phi); }

@@ -1,7 +1,7 @@
 #pragma once
 // Material parameters of the Baumgarten–Kamrin model, named as in docs/equations.md.
-// Every field carries its unit. Built only through load_preset()/validate(), which check every
-// rule below; the laws themselves assume validated parameters.
+// Every field carries its unit; parameter_table.hpp gives each its name, range and meaning. Built only through
+// load_preset()/validate(), which check every rule below; the laws themselves assume validated parameters.
 #include <string>
 #include <vector>
 
@@ -39,6 +39,14 @@ struct GranularParams {
   double G = 3.8e5;     ///< [Pa] granular shear modulus (E16)
   double K = 8.3e5;     ///< [Pa] granular bulk modulus (E16)
   double K_0 = 1.0;     ///< [-] rate factor of the f evolution (E24)
+};
+
+/// Parameters of the fluid law (E25–E27, docs/equations.md), SI units. Not part of a preset: a
+/// scene's [fluid] table (scene::FluidConfig) and the fluid body's law (material/fluid.hpp).
+struct FluidParams {
+  double eta_0_Pa_s = 1e-3;      ///< [Pa s] fluid viscosity η_0 (E25)
+  double kappa_Pa = 1e6;         ///< [Pa] fluid bulk modulus κ (E26; not given by the paper)
+  double rho_f0_kg_m3 = 1000.0;  ///< [kg/m^3] fluid rest true density ρ_f0 (E26)
 };
 
 /// A complete parameter set: what a preset file holds.

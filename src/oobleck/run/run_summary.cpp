@@ -4,6 +4,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "oobleck/rheology/parameter_table.hpp"
 #include "oobleck/run/nodal_fields.hpp"
 
 namespace oobleck::run {
@@ -11,7 +12,6 @@ namespace oobleck::run {
 nlohmann::json parameters(const scene::SceneConfig& config, nlohmann::json& units) {
   const int D = config.grid.dim;
   const auto& s = config.material.steady;
-  const auto& g = config.material.granular;
   nlohmann::json p;
   const auto put = [&](const char* key, nlohmann::json value, const char* unit) {
     p[key] = std::move(value);
@@ -19,26 +19,12 @@ nlohmann::json parameters(const scene::SceneConfig& config, nlohmann::json& unit
   };
   p["preset"] = config.material.name;
   put("phi", config.regions.front().phi, "1");
-  put("rho_s", g.rho_s, "kg/m^3");
-  put("rho_f", config.fluid.rho_f0_kg_m3, "kg/m^3");
-  put("eta_0", config.fluid.eta_0_Pa_s, "Pa s");
-  put("kappa", config.fluid.kappa_Pa, "Pa");
-  put("d", g.d, "m");
-  put("G", g.G, "Pa");
-  put("K", g.K, "Pa");
-  put("K_0", g.K_0, "1");
-  put("K_3", g.K_3, "1");
-  put("K_4", g.K_4, "1");
-  put("mu_1", s.mu_c, "1");
-  put("mu_2", g.mu_2 < 0 ? s.mu_c : g.mu_2, "1");
-  put("b", g.b, "1");
-  put("phi_c", s.phi_c, "1");
-  put("phi_j", s.phi_j, "1");
-  put("a_0", s.a_0, "1");
-  put("a_inf", s.a_inf, "1");
-  put("tau_star", s.tau_star, "Pa");
-  put("Delta", s.Delta, "1");
-  put("xi_dot_eps", s.xi_dot_eps, "1/s");
+  for (const rheology::Parameter& row : rheology::parameter_table()) {
+    const std::string key(row.summary_name.empty() ? row.name : row.summary_name);
+    const double v = row.section == rheology::Section::Fluid ? rheology::value(config.fluid, row)
+                                                             : rheology::effective_value(config.material, row);
+    put(key.c_str(), v, std::string(row.unit).c_str());
+  }
   nlohmann::json terms = nlohmann::json::array();
   for (const auto& t : s.eta_B_terms) terms.push_back({{"phi_i", t.phi_i}, {"alpha", t.alpha}});
   p["eta_B"] = terms;

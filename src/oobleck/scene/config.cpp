@@ -12,6 +12,7 @@
 #include "oobleck/core/error.hpp"
 #include "oobleck/io/frames.hpp"
 #include "oobleck/io/toml_reader.hpp"
+#include "oobleck/rheology/parameter_table.hpp"
 
 namespace oobleck::scene {
 
@@ -60,21 +61,15 @@ std::array<double, 3> read_vec(io::TomlReader& t, std::string_view key, int dim,
 }
 
 void set_material_overrides(rheology::Preset& p, io::TomlReader& mat) {
-  if (auto s = mat.optional_table("steady")) {
-    std::map<std::string, double*> keys = {
-        {"phi_c", &p.steady.phi_c}, {"phi_j", &p.steady.phi_j},       {"a_0", &p.steady.a_0},
-        {"a_inf", &p.steady.a_inf}, {"tau_star", &p.steady.tau_star}, {"eta_0", &p.steady.eta_0},
-        {"mu_c", &p.steady.mu_c},   {"Delta", &p.steady.Delta},       {"xi_dot_eps", &p.steady.xi_dot_eps}};
-    for (auto& [k, ptr] : keys) *ptr = s->number_or(k, *ptr);
-    s->finish();
-  }
-  if (auto g = mat.optional_table("granular")) {
-    std::map<std::string, double*> keys = {
-        {"d", &p.granular.d}, {"rho_s", &p.granular.rho_s}, {"mu_2", &p.granular.mu_2},
-        {"b", &p.granular.b}, {"K_3", &p.granular.K_3},     {"K_4", &p.granular.K_4},
-        {"G", &p.granular.G}, {"K", &p.granular.K},         {"K_0", &p.granular.K_0}};
-    for (auto& [k, ptr] : keys) *ptr = g->number_or(k, *ptr);
-    g->finish();
+  for (const rheology::Section section : {rheology::Section::Steady, rheology::Section::Granular}) {
+    auto t = mat.optional_table(rheology::section_name(section));
+    if (!t) continue;
+    for (const rheology::Parameter& row : rheology::parameter_table()) {
+      if (row.section != section) continue;
+      double& v = rheology::value(p, row);
+      v = t->number_or(row.name, v);
+    }
+    t->finish();
   }
 }
 
@@ -266,16 +261,15 @@ rheology::Preset read_material(io::TomlReader& top, const std::string& path) {
 /// [fluid]; its eta_0 (default: the material's) becomes the material's too: one viscosity for
 /// both laws.
 void read_fluid(io::TomlReader& top, SceneConfig& c) {
+  c.fluid.eta_0_Pa_s = c.material.steady.eta_0;
   if (auto f = top.optional_table("fluid")) {
-    c.fluid.rho_f0_kg_m3 = f->number_or("rho_f", c.fluid.rho_f0_kg_m3);
-    c.fluid.kappa_Pa = f->number_or("kappa", c.fluid.kappa_Pa);
-    c.fluid.eta_0_Pa_s = f->number_or("eta_0", c.material.steady.eta_0);
-    f->require(c.fluid.rho_f0_kg_m3 > 0, "rho_f", c.fluid.rho_f0_kg_m3, "must be positive [kg/m^3]");
-    f->require(c.fluid.kappa_Pa > 0, "kappa", c.fluid.kappa_Pa, "must be positive [Pa]");
-    f->require(c.fluid.eta_0_Pa_s > 0, "eta_0", c.fluid.eta_0_Pa_s, "must be positive [Pa s]");
+    for (const rheology::Parameter& row : rheology::parameter_table()) {
+      if (row.section != rheology::Section::Fluid) continue;
+      double& v = rheology::value(c.fluid, row);
+      v = f->number_or(row.name, v);
+      f->require(rheology::admissible(row, v), row.name, v, rheology::rule(row));
+    }
     f->finish();
-  } else {
-    c.fluid.eta_0_Pa_s = c.material.steady.eta_0;
   }
   c.material.steady.eta_0 = c.fluid.eta_0_Pa_s;
 }

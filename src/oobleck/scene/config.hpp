@@ -40,11 +40,8 @@ struct GridConfig {
   std::optional<double> linear_mass_floor;
 };
 
-struct FluidConfig {
-  double rho_f0_kg_m3 = 1000.0;  ///< [kg/m^3] rest true density of the fluid
-  double kappa_Pa = 1e6;         ///< [Pa] fluid bulk modulus (E26; the paper does not give it)
-  double eta_0_Pa_s = 0.0;       ///< [Pa s] fluid viscosity (default: the material's eta_0)
-};
+/// [fluid]: rho_f, kappa, eta_0 (rheology/parameter_table.cpp); eta_0 defaults to the material's.
+using FluidConfig = rheology::FluidParams;
 
 struct CouplingConfig {
   DragLaw drag = DragLaw::Beetstra;
