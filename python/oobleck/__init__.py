@@ -51,7 +51,7 @@ __version__ = "0.1.0"
 __all__ = [
     "InputError", "NumericalError", "Params", "FitResult", "Run", "presets", "load_params", "flow_curve",
     "shear_rate_dst", "structure", "volume_fraction", "viscosity_at", "fit", "point_shear", "point_relax",
-    "run", "open_run", "version", "read_rheometer",
+    "run", "open_run", "version", "read_rheometer", "parameter_table",
 ]
 
 
@@ -62,7 +62,7 @@ def version() -> str:
 
 # The topic modules import _core, InputError and Params from here, so these come
 # first. Each public object is named oobleck.NAME (help(), repr, pickling), not by its module.
-from ._parameters import load_params, presets  # noqa: E402
+from ._parameters import load_params, parameter_table, presets  # noqa: E402
 from ._rheology import (FLOW_CURVE_COLUMNS, flow_curve, shear_rate_dst, structure,  # noqa: E402,F401
                         viscosity_at, volume_fraction)
 from ._rheometer import RHEOMETER_COLUMNS, read_rheometer  # noqa: E402,F401
@@ -70,7 +70,7 @@ from ._fit import FitResult, fit  # noqa: E402
 from ._point import RELAX_COLUMNS, SHEAR_COLUMNS, point_relax, point_shear  # noqa: E402,F401
 from ._run import Frame, Run, open_run, run  # noqa: E402
 
-for _obj in (load_params, presets, flow_curve, shear_rate_dst, structure, viscosity_at, volume_fraction,
+for _obj in (load_params, parameter_table, presets, flow_curve, shear_rate_dst, structure, viscosity_at, volume_fraction,
              read_rheometer, FitResult, fit, point_relax, point_shear, Frame, Run, open_run, run,
              Params.to_dict, Params.to_toml, Params.copy, Params.__repr__, Params.__eq__):
     _obj.__module__ = __name__

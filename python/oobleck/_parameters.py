@@ -31,8 +31,20 @@ def load_params(name_or_path) -> Params:
     return _core.load_preset(s)
 
 
-_PARAM_FIELDS = ("phi_c", "phi_j", "a_0", "a_inf", "tau_star", "eta_0", "mu_c", "Delta", "xi_dot_eps")
-_GRANULAR_FIELDS = ("d", "rho_s", "mu_2", "b", "K_3", "K_4", "G", "K", "K_0")
+# The parameters' names in the order of the table (src/oobleck/rheology/parameter_table.cpp).
+_PARAM_FIELDS = tuple(r["name"] for r in _core.parameter_table() if r["section"] == "steady")
+_GRANULAR_FIELDS = tuple(r["name"] for r in _core.parameter_table() if r["section"] == "granular")
+
+
+def parameter_table():
+    """Every steady, granular and fluid parameter as a pandas DataFrame, one row each: name,
+    section (the TOML table: ``steady``/``granular`` in a preset or a scene's ``[material]``,
+    ``fluid`` in a scene's ``[fluid]``), unit (SI, ``1`` for dimensionless), default (``required``
+    for what a preset must give), range (and its ends lower/upper, open or not), equation
+    (docs/equations.md) and meaning. The same table drives the preset reader, the checks,
+    summary.json and the :class:`Params` properties (docs/scenes.md lists it)."""
+    from ._args import _pandas  # (_args imports this module)
+    return _pandas().DataFrame(_core.parameter_table())
 
 
 def _to_dict(self) -> dict:
