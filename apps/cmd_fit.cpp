@@ -30,6 +30,7 @@
 #include "oobleck/rheology/fit.hpp"
 #include "oobleck/rheology/fit_curves.hpp"
 #include "oobleck/rheology/flow_curve.hpp"
+#include "oobleck/rheology/parameter_table.hpp"
 
 namespace oobleck::cli {
 namespace {
@@ -55,8 +56,8 @@ std::string sanitize(const std::string& s) {
 
 std::string unit_of(const std::string& name) {
   if (name.find("phi_i") != std::string::npos) return "[1/(Pa s)]";
-  if (name == "tau_star") return "[Pa]";
-  return "[-]";
+  if (name.find("alpha") != std::string::npos) return "[-]";
+  return rheology::unit_label(rheology::parameter(rheology::Section::Steady, name));
 }
 
 std::string fmt_se(double se) { return std::isfinite(se) ? fmt::format("{:.3g}", se) : "n/a"; }

@@ -31,7 +31,7 @@ def test_params_from_dict_round_trips_to_dict_and_validates_as_a_whole():
     r = oobleck.Params.from_dict(minimal)
     assert r.K_3 == 4.715 and r.eta_B == []  # the granular defaults; no E8 terms
     with pytest.raises(oobleck.InputError, match="missing 'phi_j'"):
-        oobleck.Params.from_dict({"phi_c": 0.5})
+        oobleck.Params.from_dict({"a_0": 0.8})
     with pytest.raises(oobleck.InputError, match="did you mean 'tau_star'"):
         oobleck.Params.from_dict(dict(minimal, tau_str=1.0))
     with pytest.raises(oobleck.InputError, match="steady.phi_c"):

@@ -15,6 +15,7 @@
 #include "oobleck/rheology/f_max.hpp"
 #include "oobleck/rheology/flow_curve.hpp"
 #include "oobleck/rheology/least_squares.hpp"
+#include "oobleck/rheology/parameter_table.hpp"
 
 namespace oobleck::rheology {
 namespace {
@@ -188,10 +189,11 @@ FitResult fit_viscosity(FitKind kind, const std::vector<double>& phi, const std:
     hi = base.phi_j - kStrict;
   }
   if (!(lo < hi)) {
-    throw InputError(fmt::format("{}: no admissible {}: it must exceed the largest data phi = {}{} and stay below {}",
-                                 options.where, kind == FitKind::low ? "phi_j" : "phi_c", phi_max,
-                                 kind == FitKind::low ? fmt::format(" and the base phi_c = {}", base.phi_c) : "",
-                                 kind == FitKind::low ? "1" : fmt::format("the base phi_j = {}", base.phi_j)));
+    throw InputError(
+        fmt::format("{}: no admissible {}: it must exceed the largest data phi = {}{} and stay below {}", options.where,
+                    parameter(kind == FitKind::low ? &SteadyParams::phi_j : &SteadyParams::phi_c).name, phi_max,
+                    kind == FitKind::low ? fmt::format(" and the base phi_c = {}", base.phi_c) : "",
+                    kind == FitKind::low ? "1" : fmt::format("the base phi_j = {}", base.phi_j)));
   }
   double x[2];
   viscosity_guess(phi, eta_r, base.mu_c, lo, hi, x[0], x[1]);
@@ -223,11 +225,13 @@ FitResult fit_viscosity(FitKind kind, const std::vector<double>& phi, const std:
   if (kind == FitKind::low) {
     r.params.a_0 = x[0];
     r.params.phi_j = x[1];
-    r.parameters = {{"a_0", x[0], se_a}, {"phi_j", x[1], se_phi}};
+    r.parameters = {{std::string(parameter(&SteadyParams::a_0).name), x[0], se_a},
+                    {std::string(parameter(&SteadyParams::phi_j).name), x[1], se_phi}};
   } else {
     r.params.a_inf = x[0];
     r.params.phi_c = x[1];
-    r.parameters = {{"a_inf", x[0], se_a}, {"phi_c", x[1], se_phi}};
+    r.parameters = {{std::string(parameter(&SteadyParams::a_inf).name), x[0], se_a},
+                    {std::string(parameter(&SteadyParams::phi_c).name), x[1], se_phi}};
   }
   return r;
 }

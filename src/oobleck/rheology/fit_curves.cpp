@@ -15,6 +15,7 @@
 
 #include "oobleck/core/error.hpp"
 #include "oobleck/rheology/least_squares.hpp"
+#include "oobleck/rheology/parameter_table.hpp"
 #include "oobleck/rheology/steady_states.hpp"
 
 namespace oobleck::rheology {
@@ -25,40 +26,49 @@ constexpr double kStrict = 1e-7;     ///< strict inequalities as inclusive bound
 constexpr double kAlphaMax = 60.0;   ///< as the dst fit
 constexpr double kCondition = 1e-9;  ///< smallest singular value / largest (scaled J): below, undetermined
 
-/// One fitted parameter: which field, and whether it is fitted through its logarithm (the
-/// positive scales a_0, a_inf, tau_star, phi_i, so that steps are relative).
+/// One fitted parameter: a steady parameter of the table or an E8 term's phi_i or alpha, and
+/// whether it is fitted through its logarithm (the positive scales a_0, a_inf, tau_star, phi_i, so
+/// that steps are relative).
 struct Param {
-  enum Field { a_0, phi_j, a_inf, phi_c, tau_star, Delta, phi_i, alpha } field;
-  int term = 0;  ///< eta_B term for phi_i, alpha
+  enum Kind { scalar, phi_i, alpha } kind = scalar;
+  double SteadyParams::*member = nullptr;  ///< kind == scalar: the member its table row names
+  int term = 0;                            ///< eta_B term for phi_i, alpha
   std::string name;
   bool log = false;
   double lower = -kInf, upper = kInf;  ///< natural units
+
+  bool is(double SteadyParams::*m) const { return kind == scalar && member == m; }
 };
 
 /// The field of `s` that `q` fits (const where `s` is).
 template <class S>
 auto& slot(S& s, const Param& q) {
-  switch (q.field) {
-    case Param::a_0: return s.a_0;
-    case Param::phi_j: return s.phi_j;
-    case Param::a_inf: return s.a_inf;
-    case Param::phi_c: return s.phi_c;
-    case Param::tau_star: return s.tau_star;
-    case Param::Delta: return s.Delta;
+  switch (q.kind) {
+    case Param::scalar: return s.*q.member;
     case Param::phi_i: return s.eta_B_terms[static_cast<std::size_t>(q.term)].phi_i;
     case Param::alpha: return s.eta_B_terms[static_cast<std::size_t>(q.term)].alpha;
   }
-  return s.a_0;  // unreachable
+  return s.*q.member;  // unreachable
+}
+
+/// The table's steady rows the curves fit takes (parameter_table.hpp, CurvesFit).
+std::vector<const Parameter*> fittable_rows(bool by_default_only) {
+  std::vector<const Parameter*> rows;
+  for (const Parameter& row : parameter_table()) {
+    if (row.curves_fit == CurvesFit::by_default || (row.curves_fit == CurvesFit::when_named && !by_default_only))
+      rows.push_back(&row);
+  }
+  return rows;
 }
 
 Param parse_param(const std::string& name, const Preset& base, const std::string& where) {
-  static const std::map<std::string, Param::Field> scalars = {{"a_0", Param::a_0},           {"phi_j", Param::phi_j},
-                                                              {"a_inf", Param::a_inf},       {"phi_c", Param::phi_c},
-                                                              {"tau_star", Param::tau_star}, {"Delta", Param::Delta}};
   Param q{};
   q.name = name;
-  if (auto it = scalars.find(name); it != scalars.end()) {
-    q.field = it->second;
+  const auto rows = fittable_rows(false);
+  if (auto it = std::find_if(rows.begin(), rows.end(), [&](const Parameter* r) { return r->name == name; });
+      it != rows.end()) {
+    q.member = (*it)->steady;
+    q.log = positive_scale(**it);
   } else {
     int term = -1;
     char field[16] = {0};
@@ -70,8 +80,9 @@ Param parse_param(const std::string& name, const Preset& base, const std::string
                                      where, name, base.steady.eta_B_terms.size(),
                                      static_cast<int>(base.steady.eta_B_terms.size()) - 1));
       }
-      q.field = std::string(field) == "phi_i" ? Param::phi_i : Param::alpha;
+      q.kind = std::string(field) == "phi_i" ? Param::phi_i : Param::alpha;
       q.term = term;
+      q.log = q.kind == Param::phi_i;
     } else {
       const auto names = curves_parameter_names(base);
       const std::string hint = closest_match(name, names);
@@ -80,7 +91,6 @@ Param parse_param(const std::string& name, const Preset& base, const std::string
                                    fmt::join(names, ", ")));
     }
   }
-  q.log = q.field == Param::a_0 || q.field == Param::a_inf || q.field == Param::tau_star || q.field == Param::phi_i;
   return q;
 }
 
@@ -170,8 +180,12 @@ CurvesResidual parse_curves_residual(const std::string& text, const std::string&
       where, text));
 }
 
-std::vector<std::string> curves_parameter_names(const Preset& base) {
-  std::vector<std::string> n = {"a_0", "phi_j", "a_inf", "phi_c", "tau_star", "Delta"};
+namespace {
+
+/// The fittable steady parameters' names, then every E8 term's phi_i and alpha.
+std::vector<std::string> parameter_names(const Preset& base, bool by_default_only) {
+  std::vector<std::string> n;
+  for (const Parameter* row : fittable_rows(by_default_only)) n.emplace_back(row->name);
   for (std::size_t i = 0; i < base.steady.eta_B_terms.size(); ++i) {
     n.push_back(fmt::format("eta_B[{}].phi_i", i));
     n.push_back(fmt::format("eta_B[{}].alpha", i));
@@ -179,14 +193,11 @@ std::vector<std::string> curves_parameter_names(const Preset& base) {
   return n;
 }
 
-std::vector<std::string> curves_default_parameters(const Preset& base) {
-  std::vector<std::string> n = {"a_0", "phi_j", "a_inf", "phi_c", "tau_star"};
-  for (std::size_t i = 0; i < base.steady.eta_B_terms.size(); ++i) {
-    n.push_back(fmt::format("eta_B[{}].phi_i", i));
-    n.push_back(fmt::format("eta_B[{}].alpha", i));
-  }
-  return n;
-}
+}  // namespace
+
+std::vector<std::string> curves_parameter_names(const Preset& base) { return parameter_names(base, false); }
+
+std::vector<std::string> curves_default_parameters(const Preset& base) { return parameter_names(base, true); }
 
 void validate_curves_data(const std::vector<double>& phi, const std::vector<double>& shear_rate,
                           const std::vector<double>& shear_stress, const Preset& base,
@@ -267,8 +278,8 @@ CurvesData curves_data(const std::vector<double>& phi, const std::vector<double>
   return d;
 }
 
-bool is_fitted(const std::vector<Param>& params, Param::Field f) {
-  return std::any_of(params.begin(), params.end(), [f](const Param& q) { return q.field == f; });
+bool is_fitted(const std::vector<Param>& params, double SteadyParams::*m) {
+  return std::any_of(params.begin(), params.end(), [m](const Param& q) { return q.is(m); });
 }
 
 /// The parameters `names`, in their order; InputError for a name listed twice or unknown, and for
@@ -282,7 +293,7 @@ std::vector<Param> fitted_parameters(const std::vector<std::string>& names, cons
     }
     params.push_back(parse_param(n, base, w));
   }
-  if (!is_fitted(params, Param::phi_j)) {
+  if (!is_fitted(params, &SteadyParams::phi_j)) {
     for (std::size_t k = 0; k < phi.size(); ++k) {
       if (!(phi[k] < base.steady.phi_j)) {
         throw InputError(fmt::format(
@@ -300,28 +311,25 @@ std::vector<Param> fitted_parameters(const std::vector<std::string>& names, cons
 void set_bounds(std::vector<Param>& params, const Preset& base, double max_phi, const CurvesFitOptions& options,
                 const std::vector<std::string>& names) {
   const std::string& w = options.where;
-  const bool phi_j_fitted = is_fitted(params, Param::phi_j), phi_c_fitted = is_fitted(params, Param::phi_c);
+  const bool phi_j_fitted = is_fitted(params, &SteadyParams::phi_j),
+             phi_c_fitted = is_fitted(params, &SteadyParams::phi_c);
   for (Param& q : params) {
-    switch (q.field) {
-      case Param::phi_j:
-        q.lower = std::max(max_phi, phi_c_fitted ? 0.0 : base.steady.phi_c) + kStrict;
-        q.upper = 1.0 - kStrict;
-        break;
-      case Param::phi_c:
-        q.lower = kStrict;
-        q.upper = (phi_j_fitted ? 1.0 : base.steady.phi_j) - kStrict;
-        break;
-      case Param::Delta:
-        q.lower = 0.0;
-        q.upper = 1.0;
-        break;
-      case Param::alpha:
-        q.lower = 0.0;
-        q.upper = kAlphaMax;
-        break;
-      default:  // positive scales, fitted through their logarithm
-        q.lower = 0.0;
-        q.upper = kInf;
+    if (q.is(&SteadyParams::phi_j)) {
+      q.lower = std::max(max_phi, phi_c_fitted ? 0.0 : base.steady.phi_c) + kStrict;
+      q.upper = 1.0 - kStrict;
+    } else if (q.is(&SteadyParams::phi_c)) {
+      q.lower = kStrict;
+      q.upper = (phi_j_fitted ? 1.0 : base.steady.phi_j) - kStrict;
+    } else if (q.kind == Param::alpha) {
+      q.lower = 0.0;
+      q.upper = kAlphaMax;
+    } else if (q.kind == Param::phi_i) {  // positive, fitted through its logarithm
+      q.lower = 0.0;
+      q.upper = kInf;
+    } else {  // the table's range (positive scales: (0, inf), through their logarithm; Delta: [0, 1])
+      const Parameter& row = parameter(Section::Steady, q.name);
+      q.lower = row.lower;
+      q.upper = row.upper;
     }
   }
   for (const ParameterBounds& b : options.bounds) {
@@ -350,10 +358,10 @@ std::vector<double> start_point(const std::vector<Param>& params, const SteadyPa
   for (std::size_t i = 0; i < params.size(); ++i) {
     const Param& q = params[i];
     double v = slot(base, q);
-    if (!(v > q.lower)) v = q.field == Param::phi_j ? std::min(q.lower + 0.01, 0.5 * (q.lower + q.upper)) : q.lower;
+    if (!(v > q.lower)) v = q.is(&SteadyParams::phi_j) ? std::min(q.lower + 0.01, 0.5 * (q.lower + q.upper)) : q.lower;
     if (!(v < q.upper)) v = q.upper;
     if (q.log && !(v > 0.0)) v = 1.0;
-    if (q.log && q.field == Param::phi_i && v <= 0.0) v = 1.0;
+    if (q.log && q.kind == Param::phi_i && v <= 0.0) v = 1.0;
     x[i] = q.log ? std::log(v) : v;
   }
   return x;
@@ -514,10 +522,10 @@ std::optional<Undetermined> loose_parameters(const Eigen::MatrixXd& cov, const s
   for (std::size_t i = 0; i < params.size(); ++i) {
     const double se = std::sqrt(cov(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)));
     const Param& q = params[i];
-    const double limit = q.log                     ? std::log(1000.0)
-                         : q.field == Param::alpha ? 10.0
-                         : q.field == Param::Delta ? 1.0
-                                                   : 0.1;
+    const double limit = q.log                        ? std::log(1000.0)
+                         : q.kind == Param::alpha     ? 10.0
+                         : q.is(&SteadyParams::Delta) ? 1.0
+                                                      : 0.1;
     if (!(se <= limit)) {
       const std::string range = q.log ? fmt::format("1 sigma: a factor {:.3g}", std::exp(std::min(se, 700.0)))
                                       : fmt::format("1 sigma: +- {:.3g}", se);

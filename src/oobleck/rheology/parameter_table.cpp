@@ -61,6 +61,11 @@ constexpr Parameter fluid(std::string_view name, double FluidParams::*member, st
   return p;
 }
 
+constexpr Parameter fitted(Parameter p, CurvesFit how) {
+  p.curves_fit = how;
+  return p;
+}
+
 constexpr Parameter with_summary_name(Parameter p, std::string_view summary_name) {
   p.summary_name = summary_name;
   return p;
@@ -82,15 +87,20 @@ using F = FluidParams;
 
 const std::array kTable{
     // steady model (paper Tables 1–3)
-    steady("phi_c", &S::phi_c, "1", kOpenUnit, true, "E1", "frictional jamming fraction φ_c (< φ_j)"),
-    steady("phi_j", &S::phi_j, "1", kOpenUnit, true, "E1", "frictionless jamming fraction φ_j"),
-    steady("a_0", &S::a_0, "1", kPositive, true, "E2", "dilation parameter a at f = 0"),
-    steady("a_inf", &S::a_inf, "1", kPositive, true, "E2", "dilation parameter a at f = 1"),
-    steady("tau_star", &S::tau_star, "Pa", kPositive, true, "E7", "repulsive stress scale τ*"),
+    fitted(steady("a_0", &S::a_0, "1", kPositive, true, "E2", "dilation parameter a at f = 0"), CurvesFit::by_default),
+    fitted(steady("phi_j", &S::phi_j, "1", kOpenUnit, true, "E1", "frictionless jamming fraction φ_j"),
+           CurvesFit::by_default),
+    fitted(steady("a_inf", &S::a_inf, "1", kPositive, true, "E2", "dilation parameter a at f = 1"),
+           CurvesFit::by_default),
+    fitted(steady("phi_c", &S::phi_c, "1", kOpenUnit, true, "E1", "frictional jamming fraction φ_c (< φ_j)"),
+           CurvesFit::by_default),
+    fitted(steady("tau_star", &S::tau_star, "Pa", kPositive, true, "E7", "repulsive stress scale τ*"),
+           CurvesFit::by_default),
     steady("eta_0", &S::eta_0, "Pa s", kPositive, true, "E3, E25", "fluid viscosity η_0"),
     with_summary_name(steady("mu_c", &S::mu_c, "1", kPositive, true, "E3, E5, E20", "contact friction μ_c (= μ_1)"),
                       "mu_1"),
-    steady("Delta", &S::Delta, "1", kClosedUnit, false, "E9", "compliance parameter Δ of f_m"),
+    fitted(steady("Delta", &S::Delta, "1", kClosedUnit, false, "E9", "compliance parameter Δ of f_m"),
+           CurvesFit::when_named),
     steady("xi_dot_eps", &S::xi_dot_eps, "1/s", kNonNegative, false, "E7",
            "Brownian/electrostatic structure decay rate ξ̇_ε"),
     // time-dependent granular law
@@ -140,6 +150,13 @@ const Parameter& parameter(Section section, std::string_view name) {
                                hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint), fmt::join(names, ", ")));
 }
 
+const Parameter& parameter(double SteadyParams::*member) {
+  for (const Parameter& row : kTable) {
+    if (row.steady == member) return row;
+  }
+  throw std::logic_error("a steady member with no row in the parameter table");
+}
+
 double& value(Preset& p, const Parameter& row) {
   if (row.steady != nullptr) return p.steady.*row.steady;
   if (row.granular != nullptr) return p.granular.*row.granular;
@@ -184,6 +201,8 @@ std::string default_text(const Parameter& row) {
   if (v < 0.0 && !row.unset_means.empty()) return std::string(row.unset_means);
   return format_number(v);
 }
+
+bool positive_scale(const Parameter& row) { return row.lower == 0.0 && row.lower_open && !std::isfinite(row.upper); }
 
 bool admissible(const Parameter& row, double v) {
   if (!std::isfinite(v)) return false;

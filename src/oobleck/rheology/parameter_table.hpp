@@ -24,6 +24,10 @@ enum class Section { Steady, Granular, Fluid };
 /// "steady", "granular" or "fluid": the TOML table name.
 std::string_view section_name(Section s);
 
+/// Whether the flow-curves fit (fit_curves.hpp) fits a steady parameter: by default, only when
+/// named, or never.
+enum class CurvesFit { never, by_default, when_named };
+
 /// One row of the table.
 struct Parameter {
   std::string_view name;  ///< key in its TOML table, Python attribute, summary.json key
@@ -42,6 +46,8 @@ struct Parameter {
   /// The default as docs/scenes.md states it where the member's default is not the whole story
   /// (fluid eta_0: the material's); "" otherwise.
   std::string_view default_note;
+  /// The flow-curves fit: whether it fits this parameter (steady rows only).
+  CurvesFit curves_fit = CurvesFit::never;
   /// summary.json's key where it differs from `name` (mu_c is written as "mu_1").
   std::string_view summary_name;
   double SteadyParams::*steady = nullptr;      ///< the member (Section::Steady)
@@ -49,11 +55,15 @@ struct Parameter {
   double FluidParams::*fluid = nullptr;        ///< the member (Section::Fluid)
 };
 
-/// Every parameter, steady then granular then fluid, in the order of docs/scenes.md.
+/// Every parameter, steady then granular then fluid, in the order of docs/scenes.md (the steady
+/// ones in the order the flow-curves fit lists them: a_0, phi_j, a_inf, phi_c, tau_star, ...).
 std::span<const Parameter> parameter_table();
 
 /// The row of `name` in `section`; an unknown name is an InputError listing the known ones.
 const Parameter& parameter(Section section, std::string_view name);
+
+/// The row of a steady member (&SteadyParams::a_0): its name where code knows the member.
+const Parameter& parameter(double SteadyParams::*member);
 
 /// The member a steady or granular row names, in a preset (logic_error for a fluid row).
 double& value(Preset& p, const Parameter& row);
@@ -73,6 +83,9 @@ double default_value(const Parameter& row);
 /// The default as tables state it: "required", the default note, what an unset value means
 /// (mu_2: "mu_c"), or the number.
 std::string default_text(const Parameter& row);
+
+/// Whether a positive scale with no upper end (a_0, tau_star, ...): fits step through its logarithm.
+bool positive_scale(const Parameter& row);
 
 /// Whether `v` is admissible for `row`: finite, inside the range, or negative where the row has
 /// an unset meaning.
