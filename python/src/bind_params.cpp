@@ -114,7 +114,7 @@ void bind_params(py::module_& m) {
                                       "steady rheology) and granular law (docs/equations.md, time-dependent granular "
                                       "law). Every assignment is validated (oobleck.InputError).");
   params.def(py::init([](const rheology::Preset& p) { return p; }), py::arg("other"), "a copy");
-  params.def_static("from_dict", &from_dict, py::arg("d"),
+  params.def_static("from_dict", &from_dict, py::arg("values"),
                     "A parameter set from a dict with the keys of to_dict(): the parameters by name (those a "
                     "preset must give are required, the others take their defaults), eta_B as a list of "
                     "{'phi_i', 'alpha'} or (phi_i, alpha), and optionally name, source, units; validated as a "
