@@ -239,7 +239,7 @@ nlohmann::json annular_slow(Reproduction& r, const std::string& threads) {
                   OOBLECK_SOURCE_DIR, r.out, threads, qs),
       "S1 annular shear, u_i = 0.84 mm/s (Fig. 6)");
   r.plot("plot_annular.py", {r.out + "/annular_slow", r.out + "/annular_slow.png"});
-  const nlohmann::json slow = r.summary("annular_slow");
+  nlohmann::json slow = r.summary("annular_slow");
   std::string dists;
   double worst = 0.0;
   for (std::size_t k = 0; k < slow["profiles"].size(); ++k) {
