@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "oobleck/mpm/body.hpp"
+#include "oobleck/mpm/fields.hpp"
 #include "oobleck/mpm/grid.hpp"
 #include "oobleck/mpm/parallel.hpp"
 #include "oobleck/mpm/shape.hpp"
@@ -74,6 +75,22 @@ struct GridField {
   }
   int nodes() const { return static_cast<int>(mass_kg.size()); }
   int max_threads() const { return static_cast<int>(t_mass.size()) + 1; }
+  /// The nodal arrays and their halo rules (fields.hpp; docs/mpi.md): P2G's sums (with
+  /// `split_pressure`, the fluid's, also its pressure force and mixture volume) are completed on
+  /// their owners, the velocities copied out from them; the friction walls' records stay local.
+  void declare_nodal_fields(NodalFieldList& list, bool split_pressure) {
+    const HaloRule fluid_sums = split_pressure ? HaloRule::sum_after_p2g : HaloRule::none;
+    list.add("mass", mass_kg, HaloRule::sum_after_p2g);
+    list.add("momentum", momentum, HaloRule::sum_after_p2g);
+    list.add("force", force_N, HaloRule::sum_after_p2g);
+    list.add("pressure_force", pressure_force_N, fluid_sums);
+    list.add("volume", volume_m3, fluid_sums);
+    list.add("velocity", velocity, HaloRule::copy_before_flux);
+    list.add("velocity_old", velocity_old, HaloRule::copy_before_flux);
+    list.add("wall_normal_momentum", wall_normal_momentum, HaloRule::none);
+    list.add("wall_normal_force", wall_normal_force, HaloRule::none);
+    list.add("wall_mass_difference", wall_mass_difference, HaloRule::none);
+  }
 };
 
 namespace detail {
