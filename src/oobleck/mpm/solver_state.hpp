@@ -3,6 +3,8 @@
 // fields, the third bodies and contact pairs, the decomposition, and the scratch of the phases.
 // Solver<G> (solver.hpp) owns one SolverState and is its public interface; the phases
 // (mpm/phases/*.hpp) are functions of (team, state) and the step (step.hpp) calls them in order.
+// The phases are declared inline: GCC's inliner gives inline functions its larger limits (the
+// node kernels, e.g. predict_node, stay inlined into the grid pass).
 #include <cmath>
 #include <cstdint>
 #include <memory>

@@ -17,13 +17,13 @@ namespace oobleck::mpm {
 
 /// A decomposed run's nodal exchange `rule`: the registry's arrays of that rule (Halo::apply).
 template <class G>
-void halo_exchange(SolverState<G>& s, HaloRule rule) {
+inline void halo_exchange(SolverState<G>& s, HaloRule rule) {
   s.timed_exchange([&] { s.halo->apply(rule, s.nodal_fields().exchanged(rule)); });
 }
 
 /// The step with kernels of S nodes per axis (K = S^D in all).
 template <class G, int S>
-void step_kernel(SolverState<G>& s) {
+inline void step_kernel(SolverState<G>& s) {
   constexpr int K = S * S * (G::dim == 3 ? S : 1);
   double t_lap = parallel::wall_time();  // the timings' laps (StepTimings)
   auto lap = [&](double& acc) {
@@ -103,7 +103,7 @@ void step_kernel(SolverState<G>& s) {
 
 /// One step of length opt.dt_s: step_kernel for the shape functions' support, then the clock.
 template <class G>
-void step(SolverState<G>& s) {
+inline void step(SolverState<G>& s) {
   static_assert(G::dim == 2 || G::dim == 3);
   switch (kernel_support(s.opt.shape)) {
     case 2: step_kernel<G, 2>(s); break;

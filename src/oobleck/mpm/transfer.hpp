@@ -101,6 +101,10 @@ using V2 = Eigen::Matrix<double, 2, 1>;
 template <int S>
 struct SecondAxisFactors {
   V2 w[S], dw[S], wo[S], w_dw[S];
+  // (always inlined: P2G and G2P per point, their factors in registers)
+#if defined(__GNUC__)
+  [[gnu::always_inline]]
+#endif
   explicit SecondAxisFactors(const Stencil<2, S>& st) {
     for (int j1 = 0; j1 < S; ++j1) {
       w_dw[j1] = V2(st.w[j1][1], st.dw[j1][1]);

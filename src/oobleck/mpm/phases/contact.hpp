@@ -17,14 +17,14 @@ namespace oobleck::mpm::phases {
 
 /// Phase 1: the velocity-level motors of driven bodies (plane strain and 3D).
 template <class G>
-void apply_motors(SolverState<G>& s) {
+inline void apply_motors(SolverState<G>& s) {
   if constexpr (!std::is_same_v<G, Axisymmetric>)
     for (auto& m : s.motors) apply_motor(m, *s.bodies[m.body], s.global_grid(), s.dec != nullptr, s.opt.dt_s);
 }
 
 /// The box around every contact solid's points (over every rank), grown by two kernel widths.
 template <class G>
-ContactBox<G::dim> box_around_contact_solids(const SolverState<G>& s) {
+inline ContactBox<G::dim> box_around_contact_solids(const SolverState<G>& s) {
   constexpr int D = G::dim;
   const Grid<D>& grid = s.global_grid();
   Vec<D> ref = Vec<D>::Constant(INFINITY);  // the first solid's reference point (every rank's)
@@ -60,7 +60,7 @@ ContactBox<G::dim> box_around_contact_solids(const SolverState<G>& s) {
 /// on the nodes another rank owns), the arrays part 2 fills, and the box of the mixture's points
 /// near the solids (part 2's scatter_mass_gradient_near).
 template <class G>
-void prepare_rigid_and_contact(SolverState<G>& s) {
+inline void prepare_rigid_and_contact(SolverState<G>& s) {
   constexpr int D = G::dim;
   for (int b = 0; b < s.body_count(); ++b) {
     if (!s.rigid[b].rigid()) continue;
@@ -94,7 +94,7 @@ void prepare_rigid_and_contact(SolverState<G>& s) {
 /// P2G and writes only contact arrays, so it runs on one thread while the others start the grid
 /// pass.
 template <class G, int K>
-void scatter_contact_gradients(SolverState<G>& s) {
+inline void scatter_contact_gradients(SolverState<G>& s) {
   if (s.contacts.empty()) return;
   GridField<G>* fluid = s.fluid >= 0 ? &s.fields[s.fluid] : nullptr;
   bool combined = false;  // (the mixture's gradient is shared by the pairs)
@@ -123,7 +123,7 @@ void scatter_contact_gradients(SolverState<G>& s) {
 /// their owners): every pair's impulses (docs/contact.md, contact.hpp), then the free rigid
 /// bodies' new velocity V = V + Δt g + (Σ impulses)/M on their free components.
 template <class G>
-void resolve_contacts(SolverState<G>& s) {
+inline void resolve_contacts(SolverState<G>& s) {
   constexpr int D = G::dim, NC = G::ncomp;
   if (s.contacts.empty()) {
     for (auto& rm : s.rigid) rm.velocity_m_s = rm.predicted_m_s;
@@ -163,7 +163,7 @@ void resolve_contacts(SolverState<G>& s) {
 /// anchor moves with the body, as its points did in phase 6; a shape is built at its first use,
 /// from the moved points.)
 template <class G>
-void keep_mixture_out_of_free_rigid_bodies(SolverState<G>& s) {
+inline void keep_mixture_out_of_free_rigid_bodies(SolverState<G>& s) {
   for (auto& c : s.contacts) {
     if (s.rigid[c.solid].kind != BodyMotion::FreeRigid) continue;
     if (c.shape.built)

@@ -24,7 +24,7 @@ namespace oobleck::mpm::phases {
 /// The linear kernels' mass floor (SolverOptions::linear_mass_floor): per body floor · Σ m_p / Σ V0_p
 /// (over every rank), per node the measure V_i; once, at the first step (or when bodies change).
 template <class G>
-void prepare_mass_floor(SolverState<G>& s) {
+inline void prepare_mass_floor(SolverState<G>& s) {
   if (s.mass_floor_density.size() == s.bodies.size()) return;
   std::vector<double> sums(2 * s.bodies.size(), 0.0);
   for (std::size_t b = 0; b < s.bodies.size(); ++b)
@@ -50,7 +50,7 @@ void prepare_mass_floor(SolverState<G>& s) {
 /// Before the region: the deformable solids whose predictions the pass over the nodes makes (the
 /// wheel; without a fluid body, the grains too), and the nodal porosity's size (mixture).
 template <class G>
-void prepare_grid_pass(SolverState<G>& s) {
+inline void prepare_grid_pass(SolverState<G>& s) {
   s.solids.clear();
   for (int b = 0; b < s.body_count(); ++b)
     if (!s.rigid[b].rigid() && b != s.grains && b != s.fluid) s.solids.push_back(&s.fields[b]);
@@ -64,7 +64,7 @@ void prepare_grid_pass(SolverState<G>& s) {
 /// Body b: the walls' ghost contributions folded onto their mirrors, and a rigid body's nodal
 /// velocities predicted from the folded masses.
 template <class G>
-void fold_and_predict(SolverState<G>& s, int b) {
+inline void fold_and_predict(SolverState<G>& s, int b) {
   fold_wall_images<G>(s.grid, s.bc, s.fields[b]);
   if (s.rigid[b].rigid()) predict_rigid(s.rigid[b], s.fields[b], s.opt.gravity_m_s2, s.opt.dt_s);
 }
@@ -72,7 +72,7 @@ void fold_and_predict(SolverState<G>& s, int b) {
 /// Step 3(b) at node i: v_old = mv/m, v = (mv + Δt f)/m; with the linear kernels' mass floor
 /// (SolverOptions::linear_mass_floor) v = mv/m + Δt f/max(m, floor).
 template <class G>
-void predict_node(const SolverState<G>& s, GridField<G>& field, int i, double dt) {
+inline void predict_node(const SolverState<G>& s, GridField<G>& field, int i, double dt) {
   const double m = field.mass_kg[i];
   if (m > 0.0) {
     field.velocity_old[i] = field.momentum[i] / m;
@@ -91,7 +91,7 @@ void predict_node(const SolverState<G>& s, GridField<G>& field, int i, double dt
 /// Without a fluid body, every thread: the predictions of the solids (prepare_grid_pass) over its
 /// share of the nodes.
 template <class G>
-void predict_solids(const parallel::Team& team, SolverState<G>& s) {
+inline void predict_solids(const parallel::Team& team, SolverState<G>& s) {
   const double dt = s.opt.dt_s;
   const parallel::Range r = team.share(s.grid.node_count());
   for (GridField<G>* sf : s.solids)
@@ -110,7 +110,7 @@ void predict_solids(const parallel::Team& team, SolverState<G>& s) {
 ///    coefficients of the block's mixture nodes are computed at once (their powers in vector
 ///    lanes).
 template <class G>
-void couple_nodes(SolverState<G>& st, int i0, int count) {
+inline void couple_nodes(SolverState<G>& st, int i0, int count) {
   constexpr int NC = G::ncomp;
   constexpr int kBlock = numerics::kMathBlock;
   const double dt = st.opt.dt_s;
@@ -167,7 +167,7 @@ void couple_nodes(SolverState<G>& st, int i0, int count) {
 /// out dynamically (each node is independent: the same values whichever thread computes it; a
 /// thread that ran a side task joins when it is done).
 template <class G>
-void couple_node_blocks(const parallel::Team& team, SolverState<G>& s) {
+inline void couple_node_blocks(const parallel::Team& team, SolverState<G>& s) {
   constexpr int kBlock = numerics::kMathBlock;
   const int nn = s.grid.node_count();
   const int blocks = (nn + kBlock - 1) / kBlock;

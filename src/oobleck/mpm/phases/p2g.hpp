@@ -17,7 +17,7 @@ namespace oobleck::mpm::phases {
 
 /// f(kernel) with the kernel object of the step's shape functions (support K nodes in all).
 template <class G, int K, class F>
-void with_step_kernel(const SolverState<G>& s, F&& f) {
+inline void with_step_kernel(const SolverState<G>& s, F&& f) {
   with_kernel(s.opt.shape, s.opt.gimp_half_width_cells, [&](auto kernel) {
     if constexpr (decltype(kernel)::support == support_of<G::dim>(K)) f(kernel);
     // (other supports not reached: the step's dispatch and with_kernel read the same option)
@@ -27,7 +27,7 @@ void with_step_kernel(const SolverState<G>& s, F&& f) {
 /// Before the region: the threads of the step's regions, and each body's shape cache made ready
 /// for the scatter (detail::p2g_prepare).
 template <class G, int K>
-void p2g_prepare(SolverState<G>& s) {
+inline void p2g_prepare(SolverState<G>& s) {
   parallel::set_threads(s.threads);
   for (int b = 0; b < s.body_count(); ++b)
     with_step_kernel<G, K>(
@@ -38,7 +38,7 @@ void p2g_prepare(SolverState<G>& s) {
 /// Every thread: its static share of every body's points scattered into its copy of the body's
 /// nodal sums (shape functions, mass, momentum, forces; detail::p2g_scatter_range).
 template <class G, int K>
-void p2g_scatter(const parallel::Team& team, SolverState<G>& s) {
+inline void p2g_scatter(const parallel::Team& team, SolverState<G>& s) {
   const bool apic = s.opt.transfer == Transfer::Apic;
   for (int b = 0; b < s.body_count(); ++b)
     with_step_kernel<G, K>(s, [&](auto kernel) {
@@ -51,13 +51,13 @@ void p2g_scatter(const parallel::Team& team, SolverState<G>& s) {
 /// Every thread, after the scatter's barrier: the threads' copies summed over its share of the
 /// nodes, body after body, and gravity f_i += m_i g (detail::p2g_sum_nodes).
 template <class G>
-void p2g_sum(const parallel::Team& team, SolverState<G>& s) {
+inline void p2g_sum(const parallel::Team& team, SolverState<G>& s) {
   for (int b = 0; b < s.body_count(); ++b) detail::p2g_sum_share(team, s.fields[b], b == s.fluid, &s.opt.gravity_m_s2);
 }
 
 /// After the region: a point whose support left the grid stops the run, naming its body.
 template <class G>
-void p2g_check(const SolverState<G>& s) {
+inline void p2g_check(const SolverState<G>& s) {
   for (int b = 0; b < s.body_count(); ++b)
     if (s.p2g_outside[b] > 0)
       throw NumericalError(

@@ -66,7 +66,7 @@ namespace phases {
 /// Before the region: rigid bodies' points moved with their body; the G2P bodies (the deformable
 /// ones) and the law bodies (costliest first) listed; the per-body results reset; the flux sized.
 template <class G>
-void prepare_points(SolverState<G>& s) {
+inline void prepare_points(SolverState<G>& s) {
   const int nb = s.body_count();
   s.non_finite_kinematics.assign(s.bodies.size(), kAllFinite);
   s.g2p_bodies.clear();
@@ -94,7 +94,7 @@ void prepare_points(SolverState<G>& s) {
 /// own field: the bodies handed out dynamically; a barrier follows: the flux reads the
 /// constrained velocities).
 template <class G>
-void apply_walls(const parallel::Team& team, SolverState<G>& s) {
+inline void apply_walls(const parallel::Team& team, SolverState<G>& s) {
   team.dynamic(s.body_count(), 1,
                [&](std::int64_t b) { apply_boundary_conditions<G>(s.grid, s.bc, s.fields[b], s.opt.dt_s); });
 }
@@ -103,7 +103,7 @@ void apply_walls(const parallel::Team& team, SolverState<G>& s) {
 /// [i0, i1), and (axisymmetric) which of the G2P bodies have θ velocity (or, the fluid, θ flux)
 /// on these nodes: bit k of the result for g2p_bodies[k] (g2p_without_swirl, node by node).
 template <class G>
-std::uint64_t mixture_flux_and_swirl(SolverState<G>& s, int i0, int i1) {
+inline std::uint64_t mixture_flux_and_swirl(SolverState<G>& s, int i0, int i1) {
   std::uint64_t swirl = 0;
   if (s.fluid >= 0) {
     const GridField<G>& sf = s.fields[s.grains >= 0 ? s.grains : s.fluid];  // n = 1 without grains
@@ -134,7 +134,7 @@ std::uint64_t mixture_flux_and_swirl(SolverState<G>& s, int i0, int i1) {
 /// grids of 512 nodes and more (the intruder's 2200: 0.7% of the samples on the master when
 /// serial); smaller ones on the first thread, the others going on to the barrier that follows.
 template <class G>
-void flux_and_swirl(const parallel::Team& team, SolverState<G>& s) {
+inline void flux_and_swirl(const parallel::Team& team, SolverState<G>& s) {
   const int nn = s.grid.node_count();
   std::uint64_t mine = 0;
   if (nn >= kParallelMinNodes / 64) {
@@ -149,7 +149,7 @@ void flux_and_swirl(const parallel::Team& team, SolverState<G>& s) {
 /// On one thread, after the swirl test: the G2P tasks of the deformable bodies (their kernels
 /// chosen by the test) and the stealing shares of the G2P tasks and of the law bodies.
 template <class G, int K>
-void prepare_point_tasks(SolverState<G>& s, int team) {
+inline void prepare_point_tasks(SolverState<G>& s, int team) {
   static_assert(!std::is_same_v<G, Axisymmetric> || K == 4 || K == 9 || K == 16,
                 "a new kernel support: add its axisymmetric G2P to transfer_axisymmetric.cpp");
   const int ntasks = static_cast<int>(s.g2p_bodies.size());
@@ -172,7 +172,7 @@ void prepare_point_tasks(SolverState<G>& s, int team) {
 /// Phase 6, every thread: each G2P body's blocks in static shares with stealing, no barrier
 /// between the bodies.
 template <class G>
-void g2p(const parallel::Team& team, SolverState<G>& s) {
+inline void g2p(const parallel::Team& team, SolverState<G>& s) {
   for (int k = 0; k < static_cast<int>(s.g2p_tasks.size()); ++k) {
     const std::int64_t bad = run_g2p_share(team, s.shares, k, s.g2p_tasks[k]);
     if (bad != kAllFinite) parallel::atomic_min(s.non_finite_kinematics[s.g2p_bodies[k]], bad);
@@ -181,7 +181,7 @@ void g2p(const parallel::Team& team, SolverState<G>& s) {
 
 /// Phase 7, every thread: the laws' chunks, the costliest bodies first, no barrier between them.
 template <class G>
-void laws(const parallel::Team& team, SolverState<G>& s) {
+inline void laws(const parallel::Team& team, SolverState<G>& s) {
   const int ntasks = static_cast<int>(s.g2p_tasks.size());
   for (std::size_t k = 0; k < s.law_bodies.size(); ++k) {
     const int b = s.law_bodies[k];
@@ -193,7 +193,7 @@ void laws(const parallel::Team& team, SolverState<G>& s) {
 
 /// After the region: each law's end_update, in body order.
 template <class G>
-void end_laws(SolverState<G>& s) {
+inline void end_laws(SolverState<G>& s) {
   for (int b = 0; b < s.body_count(); ++b)
     if (s.bodies[b]->law) s.bodies[b]->law->end_update(*s.bodies[b], s.opt.dt_s, s.law_first_bad[b]);
 }
