@@ -142,6 +142,12 @@ struct ContactPair {
   std::vector<double> volume_m3;           ///< nodal volume Σ N_ip V_p of the solid (sized once)
   /// Persistent state (mpm/fields.hpp): the impulse sum (the other members are per step).
   void declare_fields(FieldList& list) { list.add_values("impulse_sum", {impulse_sum_N_s.data(), NC}, "N s"); }
+  /// The nodal sums and their halo rule (fields.hpp): completed on their owners before the
+  /// impulses.
+  void declare_nodal_fields(NodalFieldList& list) {
+    list.add("contact_mass_gradient", mass_gradient, HaloRule::sum_before_contact);
+    list.add("contact_volume", volume_m3, HaloRule::sum_before_contact);
+  }
 };
 
 /// Velocity-level motor (docs/contact.md, wheel): before each step, the mean angular velocity of the

@@ -14,6 +14,8 @@
 //   run::SceneAnalysis::declare_fields, run::Snapshots::declare_fields
 //                                    a scene measurement's samples (group "analysis") and its
 //                                    counters (checkpoint attributes)
+// Beside them, NodalFieldList registers the step's nodal arrays (not persistent) with how a
+// decomposed run's halo treats each (HaloRule): the exchanges' lists are generated from it.
 // A checkpoint dataset is "GROUP/NAME", an attribute is NAME; a frame field is NAME (or
 // frame_name) of its body, or of the grid.
 #include <cstddef>
@@ -97,6 +99,60 @@ std::span<double> flat_doubles(std::vector<T>& v) {
     return {reinterpret_cast<double*>(v.data()), v.size() * static_cast<std::size_t>(T::SizeAtCompileTime)};
   }
 }
+
+/// A nodal array of the local grid: `width` doubles per node.
+struct NodalArray {
+  double* data = nullptr;
+  int width = 1;
+};
+
+template <class T>
+NodalArray nodal(std::vector<T>& v) {
+  return {flat_doubles(v).data(), element_width<T>()};
+}
+
+/// How a decomposed run's halo (halo.hpp, docs/mpi.md) treats a nodal array, and at which of the
+/// step's exchanges (step.hpp; phase numbers of docs/mpm.md).
+enum class HaloRule {
+  none,                ///< not exchanged (each rank's own values, or recomputed on every node)
+  sum_after_p2g,       ///< partial sums added into the owners' nodes after P2G (phase 2)
+  sum_before_contact,  ///< contact's partial sums added into the owners' nodes before the impulses (phase 4)
+  copy_before_flux,    ///< the owners' values copied out to the neighbours' copies after the walls (phase 5)
+};
+
+/// True for the rules whose exchange adds partial sums into the owners (Halo::sum).
+constexpr bool sums_to_owners(HaloRule rule) {
+  return rule == HaloRule::sum_after_p2g || rule == HaloRule::sum_before_contact;
+}
+
+/// One nodal array of the step and its halo rule.
+struct NodalField {
+  const char* name = "";
+  NodalArray array;
+  HaloRule halo = HaloRule::none;
+};
+
+/// The registry of the step's nodal arrays (SolverState::nodal_fields): each declared once, by
+/// its owner (GridField<G>::declare_nodal_fields, ContactPair<G>::declare_nodal_fields, the
+/// solver's mixture arrays), with its halo rule. A halo exchange takes its list from here.
+class NodalFieldList {
+ public:
+  template <class T>
+  void add(const char* name, std::vector<T>& v, HaloRule halo) {
+    fields_.push_back({name, nodal(v), halo});
+  }
+  /// The arrays of one exchange, in declaration order.
+  std::vector<NodalArray> exchanged(HaloRule rule) const {
+    std::vector<NodalArray> arrays;
+    for (const auto& f : fields_)
+      if (f.halo == rule) arrays.push_back(f.array);
+    return arrays;
+  }
+  const std::vector<NodalField>& fields() const { return fields_; }
+
+ private:
+  std::vector<NodalField> fields_;
+};
 
 /// The declarations of one or more owners, in declaration order (the frames' order).
 class FieldList {

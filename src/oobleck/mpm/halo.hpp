@@ -15,17 +15,6 @@
 
 namespace oobleck::mpm {
 
-/// A nodal array of the local grid: `width` doubles per node.
-struct NodalArray {
-  double* data = nullptr;
-  int width = 1;
-};
-
-template <class T>
-NodalArray nodal(std::vector<T>& v) {
-  return {flat_doubles(v).data(), element_width<T>()};
-}
-
 template <int D>
 class Halo {
  public:
@@ -55,6 +44,14 @@ class Halo {
       exchange(a, arrays, n, kG, 0, /*upward*/ true, /*add*/ false, 2 * a);
       exchange(a, arrays, kG, kG + 1, n + kG, /*upward*/ false, /*add*/ false, 2 * a + 1);
     }
+  }
+
+  /// The exchange of `rule` (fields.hpp) over `arrays`: sum() or copy().
+  void apply(HaloRule rule, std::span<const NodalArray> arrays) {
+    if (sums_to_owners(rule))
+      sum(arrays);
+    else if (rule == HaloRule::copy_before_flux)
+      copy(arrays);
   }
 
   /// Bytes this rank sent in the exchanges so far.

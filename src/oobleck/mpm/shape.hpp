@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "oobleck/mpm/grid.hpp"
+#include "oobleck/mpm/parallel.hpp"
 
 namespace oobleck::mpm {
 
@@ -409,8 +410,9 @@ make_stencil(const Grid<D>& grid, const StencilGrid<D>& sg, const Kernel& kernel
   return ok;
 }
 
-/// Fill the cache for all points at positions x (OpenMP over points). Returns the number of
-/// points whose support leaves the stored nodes (0 when all is well; the caller reports them).
+/// Fill the cache for all points at positions x (each thread of a region its static share of
+/// the points, parallel.hpp). Returns the number of points whose support leaves the stored nodes
+/// (0 when all is well; the caller reports them).
 template <int D, class Kernel>
 std::int64_t compute_shape_cache(const Grid<D>& grid, const Kernel& kernel, const std::vector<Vec<D>>& x,
                                  ShapeCache<D>& cache) {
@@ -419,9 +421,13 @@ std::int64_t compute_shape_cache(const Grid<D>& grid, const Kernel& kernel, cons
   cache.apic_by_gradient = Kernel::apic_by_gradient;
   const StencilGrid<D> sg(grid);
   std::int64_t bad = 0;
-#pragma omp parallel for schedule(static) reduction(+ : bad)
-  for (std::int64_t p = 0; p < np; ++p)
-    if (!make_stencil(grid, sg, kernel, x[p], cache.template stencil<Kernel::support>(p), cache.inv_D[p])) ++bad;
+  parallel::region([&](const parallel::Team& team) {
+    const parallel::Range r = team.share(np);
+    std::int64_t mine = 0;
+    for (std::int64_t p = r.begin; p < r.end; ++p)
+      if (!make_stencil(grid, sg, kernel, x[p], cache.template stencil<Kernel::support>(p), cache.inv_D[p])) ++mine;
+    if (mine > 0) parallel::atomic_add(bad, mine);
+  });
   return bad;
 }
 

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "oobleck/mpm/body.hpp"
+#include "oobleck/mpm/fields.hpp"
 #include "oobleck/mpm/grid.hpp"
 #include "oobleck/mpm/parallel.hpp"
 #include "oobleck/mpm/shape.hpp"
@@ -74,6 +75,22 @@ struct GridField {
   }
   int nodes() const { return static_cast<int>(mass_kg.size()); }
   int max_threads() const { return static_cast<int>(t_mass.size()) + 1; }
+  /// The nodal arrays and their halo rules (fields.hpp; docs/mpi.md): P2G's sums (with
+  /// `split_pressure`, the fluid's, also its pressure force and mixture volume) are completed on
+  /// their owners, the velocities copied out from them; the friction walls' records stay local.
+  void declare_nodal_fields(NodalFieldList& list, bool split_pressure) {
+    const HaloRule fluid_sums = split_pressure ? HaloRule::sum_after_p2g : HaloRule::none;
+    list.add("mass", mass_kg, HaloRule::sum_after_p2g);
+    list.add("momentum", momentum, HaloRule::sum_after_p2g);
+    list.add("force", force_N, HaloRule::sum_after_p2g);
+    list.add("pressure_force", pressure_force_N, fluid_sums);
+    list.add("volume", volume_m3, fluid_sums);
+    list.add("velocity", velocity, HaloRule::copy_before_flux);
+    list.add("velocity_old", velocity_old, HaloRule::copy_before_flux);
+    list.add("wall_normal_momentum", wall_normal_momentum, HaloRule::none);
+    list.add("wall_normal_force", wall_normal_force, HaloRule::none);
+    list.add("wall_mass_difference", wall_mass_difference, HaloRule::none);
+  }
 };
 
 namespace detail {
@@ -84,6 +101,10 @@ using V2 = Eigen::Matrix<double, 2, 1>;
 template <int S>
 struct SecondAxisFactors {
   V2 w[S], dw[S], wo[S], w_dw[S];
+  // (always inlined: P2G and G2P per point, their factors in registers)
+#if defined(__GNUC__)
+  [[gnu::always_inline]]
+#endif
   explicit SecondAxisFactors(const Stencil<2, S>& st) {
     for (int j1 = 0; j1 < S; ++j1) {
       w_dw[j1] = V2(st.w[j1][1], st.dw[j1][1]);
@@ -508,6 +529,137 @@ struct G2PSums {
   }
 };
 
+/// accumulate_g2p on a 2D grid: the tensor product factorised (as in P2G): per row j0 the sums
+/// over j1 of N_1 v_i, N'_1 v_i and N_1 o_1 v_i, then ∑N v = ∑ N_0 (∑N_1 v), ∇: (∑ N'_0 (∑N_1 v),
+/// ∑ N_0 (∑N'_1 v)), B = ∑N v (x_i − x_p)ᵀ = (∑ N_0 o_0 (∑N_1 v), ∑ N_0 (∑N_1 o_1 v)).
+template <class G, int K, bool Apic, bool ByGrad, bool Mixture, bool NoSwirl>
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void
+accumulate_g2p_2d(const ShapeCache<G::dim>& cache, std::int64_t p, const double* vel, const double* vel_old,
+                  const double* flux, const double* porosity, G2PSums<G::dim>& s) {
+  constexpr int D = G::dim, NC = G::ncomp, S = support_of<D>(K);
+  constexpr bool kTheta = NC == 3 && !NoSwirl;  // the third component's sums over the nodes
+  (void)vel_old, (void)flux, (void)porosity;    // (read by the FLIP and mixture kernels only)
+  const Stencil<D, S>& st = cache.template stencil<S>(p);
+  const SecondAxisFactors<S> a1(st);
+  OOBLECK_UNROLL
+  for (int j0 = 0; j0 < S; ++j0) {
+    const double w0 = st.w[j0][0], dw0 = st.dw[j0][0], o0 = st.off[j0][0];
+    V2 t2 = V2::Zero(), tg2 = V2::Zero(), to2 = V2::Zero(), td2 = V2::Zero(), tq2 = V2::Zero();
+    double t3 = 0.0, tg3 = 0.0, to3 = 0.0, td3 = 0.0, tq3 = 0.0, tn = 0.0, tqy = 0.0;
+    const int row = st.index[j0][0];
+    OOBLECK_UNROLL
+    for (int j1 = 0; j1 < S; ++j1) {
+      const int i = row + st.index[j1][1];
+      const double w1 = st.w[j1][1], dw1 = st.dw[j1][1];
+      const double* vi = vel + static_cast<std::int64_t>(i) * NC;
+      const V2 vi2 = Eigen::Map<const V2>(vi);
+      t2 += a1.w[j1].cwiseProduct(vi2);
+      tg2 += a1.dw[j1].cwiseProduct(vi2);
+      if constexpr (kTheta) {
+        t3 += w1 * vi[2];
+        tg3 += dw1 * vi[2];
+      }
+      if constexpr (Apic && !ByGrad) {
+        to2 += a1.wo[j1].cwiseProduct(vi2);
+        if constexpr (kTheta) to3 += (w1 * st.off[j1][1]) * vi[2];
+      }
+      if constexpr (!Apic) {
+        const double* vo = vel_old + static_cast<std::int64_t>(i) * NC;
+        td2 += a1.w[j1].cwiseProduct(vi2 - Eigen::Map<const V2>(vo));
+        if constexpr (kTheta) td3 += w1 * (vi[2] - vo[2]);
+      }
+      if constexpr (Mixture) {
+        const double* qi = flux + static_cast<std::int64_t>(i) * NC;
+        tn += w1 * porosity[i];
+        tq2 += a1.w[j1].cwiseProduct(Eigen::Map<const V2>(qi));
+        tqy += dw1 * qi[1];
+        if constexpr (kTheta) tq3 += w1 * qi[2];
+      }
+    }
+    s.vp2 += w0 * t2;
+    s.gv2[0] += dw0 * t2;
+    s.gv2[1] += w0 * tg2;
+    if constexpr (kTheta) {
+      s.vp3 += w0 * t3;
+      s.gv3[0] += dw0 * t3;
+      s.gv3[1] += w0 * tg3;
+    }
+    if constexpr (Apic && !ByGrad) {
+      s.B2[0] += (w0 * o0) * t2;
+      s.B2[1] += w0 * to2;
+      if constexpr (kTheta) {
+        s.B3[0] += (w0 * o0) * t3;
+        s.B3[1] += w0 * to3;
+      }
+    }
+    if constexpr (!Apic) {
+      s.dv2 += w0 * td2;
+      if constexpr (kTheta) s.dv3 += w0 * td3;
+    }
+    if constexpr (Mixture) {
+      s.n_p += w0 * tn;
+      s.div_q += dw0 * tq2[0] + w0 * tqy;
+      if constexpr (G::has_hoop_terms) {
+        s.q2 += w0 * tq2;
+        if constexpr (kTheta) s.q3 += w0 * tq3;
+      }
+    }
+    (void)o0;
+  }
+}
+
+/// accumulate_g2p on a 3D grid: node by node over the stencil.
+template <class G, int K, bool Apic, bool ByGrad, bool Mixture, bool NoSwirl>
+#if defined(__GNUC__)
+[[gnu::always_inline]]
+#endif
+inline void
+accumulate_g2p_nodes(const ShapeCache<G::dim>& cache, std::int64_t p, const double* vel, const double* vel_old,
+                     const double* flux, const double* porosity, G2PSums<G::dim>& s) {
+  constexpr int D = G::dim, NC = G::ncomp, S = support_of<D>(K);
+  (void)vel_old, (void)flux, (void)porosity;  // (read by the FLIP and mixture kernels only)
+  for_each_node<D, S>(cache.template stencil<S>(p), [&](int i, double w, const double* g, const double* off) {
+    const double* vi = vel + static_cast<std::int64_t>(i) * NC;
+    const V2 vi2 = Eigen::Map<const V2>(vi);
+    const double vi3 = NC == 3 ? vi[NC - 1] : 0.0;
+    if constexpr (Mixture) {
+      const double* qi = flux + static_cast<std::int64_t>(i) * NC;
+      s.n_p += w * porosity[i];
+      double d = qi[0] * g[0];
+      for (int a = 1; a < D; ++a) d += qi[a] * g[a];
+      s.div_q += d;
+      if constexpr (G::has_hoop_terms) {
+        s.q2 += w * Eigen::Map<const V2>(qi);
+        s.q3 += w * qi[2];
+      }
+    }
+    s.vp2 += w * vi2;
+    if constexpr (NC == 3) s.vp3 += w * vi3;
+    for (int a = 0; a < D; ++a) {
+      s.gv2[a] += vi2 * g[a];
+      if constexpr (NC == 3) s.gv3[a] += vi3 * g[a];
+    }
+    if constexpr (Apic) {
+      if constexpr (!ByGrad) {
+        const V2 wv2 = w * vi2;
+        const double wv3 = w * vi3;
+        for (int a = 0; a < D; ++a) {
+          s.B2[a] += wv2 * off[a];
+          if constexpr (NC == 3) s.B3[a] += wv3 * off[a];
+        }
+      }
+    } else {
+      const double* vo = vel_old + static_cast<std::int64_t>(i) * NC;
+      s.dv2 += w * (vi2 - Eigen::Map<const V2>(vo));
+      if constexpr (NC == 3) s.dv3 += w * (vi3 - vo[2]);
+    }
+    (void)off;
+  });
+}
+
 /// G2P's first half for point p (grid_to_particles_kernel): the sums over its nodes (docs/mpm.md
 /// phase 6) from the nodal velocities, old velocities (FLIP), flux and porosity (mixture).
 template <class G, int K, bool Apic, bool ByGrad, bool Mixture, bool NoSwirl>
@@ -517,119 +669,10 @@ template <class G, int K, bool Apic, bool ByGrad, bool Mixture, bool NoSwirl>
 inline void
 accumulate_g2p(const ShapeCache<G::dim>& cache, std::int64_t p, const double* vel, const double* vel_old,
                const double* flux, const double* porosity, G2PSums<G::dim>& s) {
-  constexpr int D = G::dim, NC = G::ncomp, S = support_of<D>(K);
-  constexpr bool kTheta = NC == 3 && !NoSwirl;  // the third component's sums over the nodes
-  (void)vel_old, (void)flux, (void)porosity;    // (read by the FLIP and mixture kernels only)
-  if constexpr (D == 2) {
-    // The tensor product factorised (as in P2G): per row j0 the sums over j1 of N_1 v_i,
-    // N'_1 v_i and N_1 o_1 v_i, then ∑N v = ∑ N_0 (∑N_1 v), ∇: (∑ N'_0 (∑N_1 v), ∑ N_0 (∑N'_1 v)),
-    // B = ∑N v (x_i − x_p)ᵀ = (∑ N_0 o_0 (∑N_1 v), ∑ N_0 (∑N_1 o_1 v)).
-    const Stencil<D, S>& st = cache.template stencil<S>(p);
-    const SecondAxisFactors<S> a1(st);
-    OOBLECK_UNROLL
-    for (int j0 = 0; j0 < S; ++j0) {
-      const double w0 = st.w[j0][0], dw0 = st.dw[j0][0], o0 = st.off[j0][0];
-      V2 t2 = V2::Zero(), tg2 = V2::Zero(), to2 = V2::Zero(), td2 = V2::Zero(), tq2 = V2::Zero();
-      double t3 = 0.0, tg3 = 0.0, to3 = 0.0, td3 = 0.0, tq3 = 0.0, tn = 0.0, tqy = 0.0;
-      const int row = st.index[j0][0];
-      OOBLECK_UNROLL
-      for (int j1 = 0; j1 < S; ++j1) {
-        const int i = row + st.index[j1][1];
-        const double w1 = st.w[j1][1], dw1 = st.dw[j1][1];
-        const double* vi = vel + static_cast<std::int64_t>(i) * NC;
-        const V2 vi2 = Eigen::Map<const V2>(vi);
-        t2 += a1.w[j1].cwiseProduct(vi2);
-        tg2 += a1.dw[j1].cwiseProduct(vi2);
-        if constexpr (kTheta) {
-          t3 += w1 * vi[2];
-          tg3 += dw1 * vi[2];
-        }
-        if constexpr (Apic && !ByGrad) {
-          to2 += a1.wo[j1].cwiseProduct(vi2);
-          if constexpr (kTheta) to3 += (w1 * st.off[j1][1]) * vi[2];
-        }
-        if constexpr (!Apic) {
-          const double* vo = vel_old + static_cast<std::int64_t>(i) * NC;
-          td2 += a1.w[j1].cwiseProduct(vi2 - Eigen::Map<const V2>(vo));
-          if constexpr (kTheta) td3 += w1 * (vi[2] - vo[2]);
-        }
-        if constexpr (Mixture) {
-          const double* qi = flux + static_cast<std::int64_t>(i) * NC;
-          tn += w1 * porosity[i];
-          tq2 += a1.w[j1].cwiseProduct(Eigen::Map<const V2>(qi));
-          tqy += dw1 * qi[1];
-          if constexpr (kTheta) tq3 += w1 * qi[2];
-        }
-      }
-      s.vp2 += w0 * t2;
-      s.gv2[0] += dw0 * t2;
-      s.gv2[1] += w0 * tg2;
-      if constexpr (kTheta) {
-        s.vp3 += w0 * t3;
-        s.gv3[0] += dw0 * t3;
-        s.gv3[1] += w0 * tg3;
-      }
-      if constexpr (Apic && !ByGrad) {
-        s.B2[0] += (w0 * o0) * t2;
-        s.B2[1] += w0 * to2;
-        if constexpr (kTheta) {
-          s.B3[0] += (w0 * o0) * t3;
-          s.B3[1] += w0 * to3;
-        }
-      }
-      if constexpr (!Apic) {
-        s.dv2 += w0 * td2;
-        if constexpr (kTheta) s.dv3 += w0 * td3;
-      }
-      if constexpr (Mixture) {
-        s.n_p += w0 * tn;
-        s.div_q += dw0 * tq2[0] + w0 * tqy;
-        if constexpr (G::has_hoop_terms) {
-          s.q2 += w0 * tq2;
-          if constexpr (kTheta) s.q3 += w0 * tq3;
-        }
-      }
-      (void)o0;
-    }
-  } else {
-    for_each_node<D, S>(cache.template stencil<S>(p), [&](int i, double w, const double* g, const double* off) {
-      const double* vi = vel + static_cast<std::int64_t>(i) * NC;
-      const V2 vi2 = Eigen::Map<const V2>(vi);
-      const double vi3 = NC == 3 ? vi[NC - 1] : 0.0;
-      if constexpr (Mixture) {
-        const double* qi = flux + static_cast<std::int64_t>(i) * NC;
-        s.n_p += w * porosity[i];
-        double d = qi[0] * g[0];
-        for (int a = 1; a < D; ++a) d += qi[a] * g[a];
-        s.div_q += d;
-        if constexpr (G::has_hoop_terms) {
-          s.q2 += w * Eigen::Map<const V2>(qi);
-          s.q3 += w * qi[2];
-        }
-      }
-      s.vp2 += w * vi2;
-      if constexpr (NC == 3) s.vp3 += w * vi3;
-      for (int a = 0; a < D; ++a) {
-        s.gv2[a] += vi2 * g[a];
-        if constexpr (NC == 3) s.gv3[a] += vi3 * g[a];
-      }
-      if constexpr (Apic) {
-        if constexpr (!ByGrad) {
-          const V2 wv2 = w * vi2;
-          const double wv3 = w * vi3;
-          for (int a = 0; a < D; ++a) {
-            s.B2[a] += wv2 * off[a];
-            if constexpr (NC == 3) s.B3[a] += wv3 * off[a];
-          }
-        }
-      } else {
-        const double* vo = vel_old + static_cast<std::int64_t>(i) * NC;
-        s.dv2 += w * (vi2 - Eigen::Map<const V2>(vo));
-        if constexpr (NC == 3) s.dv3 += w * (vi3 - vo[2]);
-      }
-      (void)off;
-    });
-  }
+  if constexpr (G::dim == 2)
+    accumulate_g2p_2d<G, K, Apic, ByGrad, Mixture, NoSwirl>(cache, p, vel, vel_old, flux, porosity, s);
+  else
+    accumulate_g2p_nodes<G, K, Apic, ByGrad, Mixture, NoSwirl>(cache, p, vel, vel_old, flux, porosity, s);
 }
 
 /// write_back_g2p for a 2D grid: the update written straight from the accumulators to the

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "oobleck/mpm/body.hpp"
+#include "oobleck/mpm/parallel.hpp"
 
 namespace oobleck::run {
 
@@ -15,18 +16,24 @@ struct NonFinitePoint {
   const char* what = "";  ///< "position", "velocity", "stress" or "volume"
 };
 
-/// The lowest-index point with a non-finite position, velocity, stress or volume (OpenMP over
-/// points; deterministic: the minimum index), or nullopt.
+/// The lowest-index point with a non-finite position, velocity, stress or volume (each thread of
+/// a region its static share of the points, mpm/parallel.hpp; deterministic: the minimum index),
+/// or nullopt.
 template <class G>
 std::optional<NonFinitePoint> first_non_finite(const mpm::Body<G>& body) {
   const std::int64_t n = body.size();
   std::int64_t bad = std::numeric_limits<std::int64_t>::max();
-#pragma omp parallel for schedule(static) reduction(min : bad)
-  for (std::int64_t p = 0; p < n; ++p) {
-    // One test per point: the sum is finite only if every term is (NaN and ±Inf propagate).
-    const double sum = body.x_m[p].sum() + body.v_m_s[p].sum() + body.stress_Pa[p].sum() + body.volume_m3[p];
-    if (!std::isfinite(sum)) bad = std::min(bad, p);
-  }
+  mpm::parallel::region([&](const mpm::parallel::Team& team) {
+    const mpm::parallel::Range r = team.share(n);
+    for (std::int64_t p = r.begin; p < r.end; ++p) {
+      // One test per point: the sum is finite only if every term is (NaN and ±Inf propagate).
+      const double sum = body.x_m[p].sum() + body.v_m_s[p].sum() + body.stress_Pa[p].sum() + body.volume_m3[p];
+      if (!std::isfinite(sum)) {
+        mpm::parallel::atomic_min(bad, p);
+        break;  // (the share's lowest index)
+      }
+    }
+  });
   if (bad == std::numeric_limits<std::int64_t>::max()) return std::nullopt;
   const char* what = !body.x_m[bad].allFinite()            ? "position"
                      : !body.v_m_s[bad].allFinite()        ? "velocity"

@@ -4,6 +4,8 @@
 #include <type_traits>
 #include <vector>
 
+#include "oobleck/core/build_info.hpp"
+#include "oobleck/core/comm.hpp"
 #include "oobleck/rheology/parameter_table.hpp"
 #include "oobleck/run/nodal_fields.hpp"
 
@@ -74,8 +76,85 @@ nlohmann::json bodies_summary(const scene::BuiltScene<G>& scene, nlohmann::json&
   return bodies;
 }
 
+template <class G>
+nlohmann::json run_summary(const scene::SceneConfig& cfg, const scene::BuiltScene<G>& scene,
+                           const SceneAnalysis<G>& analysis, const Snapshots<G>& snapshots, long steps_run,
+                           bool complete, double wall_s) {
+  mpm::Solver<G>& solver = *scene.solver;
+  std::int64_t points = 0;
+  nlohmann::json per_body;
+  for (int b = 0; b < solver.body_count(); ++b) {
+    points += solver.body(b).size();
+    per_body[solver.body(b).name] = comm::sum(solver.body(b).size());
+  }
+  const std::int64_t own_points = points;
+  points = comm::sum(points);
+  const auto& tm = solver.timings();
+  nlohmann::json j, units = nlohmann::json::object();  // units: {dotted key: unit} of the numbers
+  const auto put = [&](const std::string& key, nlohmann::json value, const char* unit) {
+    j[key] = std::move(value);
+    units[key] = unit;
+  };
+  j["scene"] = cfg.name;
+  j["scene_file"] = cfg.file;
+  j["geometry"] = scene::to_string(cfg.grid.geometry);
+  put("points", points, "1");
+  j["points_per_body"] = per_body;
+  for (const auto& b : per_body.items()) units["points_per_body." + b.key()] = "1";
+  put("steps", solver.steps(), "1");
+  put("steps_this_run", steps_run, "1");
+  j["complete"] = complete;
+  put("dt", scene.dt_s, "s");
+  put("time", solver.time_s(), "s");
+  put("wall_seconds", wall_s, "s");
+  put("point_updates_per_second",
+      wall_s > 0 ? static_cast<double>(points) * static_cast<double>(steps_run) / wall_s : 0.0, "1/s");
+  put("threads", solver.threads(), "1");
+  put("ranks", comm::size(), "1");
+  if (const auto* dec = solver.decomposition()) {
+    j["ranks_grid"] = dec->dims_string();
+    j["points_per_rank"] = {{"min", comm::min(own_points)},
+                            {"mean", static_cast<double>(points) / comm::size()},
+                            {"max", comm::max(own_points)}};
+    for (const char* k : {"min", "mean", "max"}) units[std::string("points_per_rank.") + k] = "1";
+    put("points_migrated", comm::sum(solver.points_migrated()), "1");
+    put("halo_bytes_sent_per_rank_per_step",
+        steps_run > 0
+            ? static_cast<double>(comm::sum(solver.halo_bytes_sent())) / comm::size() / static_cast<double>(steps_run)
+            : 0.0,
+        "1");
+  }
+  j["library_instruction_set"] = library_instruction_set();  // which CPU variant ran
+  j["timings_seconds"] = {{"p2g", tm.p2g},
+                          {"grid", tm.grid},
+                          {"g2p", tm.g2p},
+                          {"stress", tm.stress},
+                          {"communication", comm::max(tm.communication)},
+                          {"output_and_checks", wall_s - tm.total()}};
+  for (const auto& t : j["timings_seconds"].items()) units["timings_seconds." + t.key()] = "s";
+  j["parameters"] = parameters(cfg, units);
+  nlohmann::json result = analysis.result();
+  if (const auto u = result.find("units"); u != result.end()) {  // (its numbers' units)
+    units.update(*u);
+    result.erase(u);
+  }
+  j.update(result);
+  if (!scene.third.empty()) j["bodies"] = bodies_summary(scene, units);
+  if (!snapshots.files().empty()) j["snapshots"] = snapshots.files();
+  j["units"] = units;  // (the scene analysis's keys: docs/analysis.md)
+  return j;
+}
+
 template nlohmann::json bodies_summary(const scene::BuiltScene<mpm::PlaneStrain>&, nlohmann::json&);
 template nlohmann::json bodies_summary(const scene::BuiltScene<mpm::Axisymmetric>&, nlohmann::json&);
 template nlohmann::json bodies_summary(const scene::BuiltScene<mpm::ThreeD>&, nlohmann::json&);
+
+#define OOBLECK_RUN_SUMMARY(G)                                                                                         \
+  template nlohmann::json run_summary(const scene::SceneConfig&, const scene::BuiltScene<G>&, const SceneAnalysis<G>&, \
+                                      const Snapshots<G>&, long, bool, double);
+OOBLECK_RUN_SUMMARY(mpm::PlaneStrain)
+OOBLECK_RUN_SUMMARY(mpm::Axisymmetric)
+OOBLECK_RUN_SUMMARY(mpm::ThreeD)
+#undef OOBLECK_RUN_SUMMARY
 
 }  // namespace oobleck::run

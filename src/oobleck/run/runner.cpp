@@ -10,7 +10,6 @@
 
 #include <fmt/format.h>
 
-#include "oobleck/core/build_info.hpp"
 #include "oobleck/core/comm.hpp"
 #include "oobleck/core/error.hpp"
 #include "oobleck/io/checkpoint.hpp"
@@ -95,7 +94,6 @@ class SceneRun {
   mpm::FieldList state_fields();
   void write_checkpoint();
   void restore(const io::Checkpoint& cp);
-  nlohmann::json summary(long steps_run, bool complete, double wall_s) const;
 
   mpm::Solver<G>& solver() const { return *scene_.solver; }
   /// Who writes the frames and checkpoints: every rank of a decomposed run together.
@@ -332,7 +330,7 @@ nlohmann::json SceneRun<G>::run() {
   progress.finish();
   if (frames) frames->flush();
 
-  nlohmann::json j = summary(last - first, last == total, wall);
+  nlohmann::json j = run_summary(cfg_, scene_, *analysis_, snapshots_, last - first, last == total, wall);
   if (!stopped_by.empty()) j["stopped_by"] = stopped_by;
   if (retimed) j["restart_overrides"] = opt_.restart_overrides;
   if (comm::is_root()) io::write_summary(opt_.out_dir, j);
@@ -342,72 +340,6 @@ nlohmann::json SceneRun<G>::run() {
                               cfg_.name, stop_reason(stop_signal()), last, solver().time_s(), opt_.out_dir),
                   stop_signal());
   }
-  return j;
-}
-
-template <class G>
-nlohmann::json SceneRun<G>::summary(long steps_run, bool complete, double wall_s) const {
-  std::int64_t points = 0;
-  nlohmann::json per_body;
-  for (int b = 0; b < solver().body_count(); ++b) {
-    points += solver().body(b).size();
-    per_body[solver().body(b).name] = comm::sum(solver().body(b).size());
-  }
-  const std::int64_t own_points = points;
-  points = comm::sum(points);
-  const auto& tm = solver().timings();
-  nlohmann::json j, units = nlohmann::json::object();  // units: {dotted key: unit} of the numbers
-  const auto put = [&](const std::string& key, nlohmann::json value, const char* unit) {
-    j[key] = std::move(value);
-    units[key] = unit;
-  };
-  j["scene"] = cfg_.name;
-  j["scene_file"] = cfg_.file;
-  j["geometry"] = scene::to_string(cfg_.grid.geometry);
-  put("points", points, "1");
-  j["points_per_body"] = per_body;
-  for (const auto& b : per_body.items()) units["points_per_body." + b.key()] = "1";
-  put("steps", solver().steps(), "1");
-  put("steps_this_run", steps_run, "1");
-  j["complete"] = complete;
-  put("dt", scene_.dt_s, "s");
-  put("time", solver().time_s(), "s");
-  put("wall_seconds", wall_s, "s");
-  put("point_updates_per_second",
-      wall_s > 0 ? static_cast<double>(points) * static_cast<double>(steps_run) / wall_s : 0.0, "1/s");
-  put("threads", solver().threads(), "1");
-  put("ranks", comm::size(), "1");
-  if (const auto* dec = solver().decomposition()) {
-    j["ranks_grid"] = dec->dims_string();
-    j["points_per_rank"] = {{"min", comm::min(own_points)},
-                            {"mean", static_cast<double>(points) / comm::size()},
-                            {"max", comm::max(own_points)}};
-    for (const char* k : {"min", "mean", "max"}) units[std::string("points_per_rank.") + k] = "1";
-    put("points_migrated", comm::sum(solver().points_migrated()), "1");
-    put("halo_bytes_sent_per_rank_per_step",
-        steps_run > 0
-            ? static_cast<double>(comm::sum(solver().halo_bytes_sent())) / comm::size() / static_cast<double>(steps_run)
-            : 0.0,
-        "1");
-  }
-  j["library_instruction_set"] = library_instruction_set();  // which CPU variant ran
-  j["timings_seconds"] = {{"p2g", tm.p2g},
-                          {"grid", tm.grid},
-                          {"g2p", tm.g2p},
-                          {"stress", tm.stress},
-                          {"communication", comm::max(tm.communication)},
-                          {"output_and_checks", wall_s - tm.total()}};
-  for (const auto& t : j["timings_seconds"].items()) units["timings_seconds." + t.key()] = "s";
-  j["parameters"] = parameters(cfg_, units);
-  nlohmann::json result = analysis_->result();
-  if (const auto u = result.find("units"); u != result.end()) {  // (its numbers' units)
-    units.update(*u);
-    result.erase(u);
-  }
-  j.update(result);
-  if (!scene_.third.empty()) j["bodies"] = bodies_summary(scene_, units);
-  if (!snapshots_.files().empty()) j["snapshots"] = snapshots_.files();
-  j["units"] = units;  // (the scene analysis's keys: docs/analysis.md)
   return j;
 }
 
