@@ -47,11 +47,13 @@
 // inside a step (the nodal mass-gradient buffer is sized once).
 //
 // Decomposed runs (docs/mpi.md): every rank holds each rigid body's motion and each pair's sums,
-// and sees the points of its block only. The whole-body sums (mass, the motor's moments, the
-// rigid contact's normal system, the impulses) are this rank's share, completed with
-// comm::sum_ordered (`across_ranks`), which gives every rank the same bits, so the ranks advance
-// the bodies identically. The node sums count owned nodes only (the node weights are 0 on the
-// ghost nodes that another rank owns); the positions are compared on the global grid.
+// and sees the points of its block only. The functions here talk to no other rank: each returns
+// (or adds to) this rank's share of a whole-body sum — the motor's moments (BodyMoments), the
+// rigid contact's normal system (RigidSystem), a pair's impulses (PairSums) — and the step
+// (mpm/phases/contact.hpp) completes the shares over the ranks with comm::sum_ordered, which gives
+// every rank the same bits, so the ranks advance the bodies identically. The node sums count owned
+// nodes only (the node weights are 0 on the ghost nodes that another rank owns); the positions are
+// compared on the global grid.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -60,7 +62,6 @@
 #include <vector>
 #include <Eigen/LU>
 
-#include "oobleck/core/comm.hpp"
 #include "oobleck/mpm/body.hpp"
 #include "oobleck/mpm/boundary.hpp"
 #include "oobleck/mpm/fields.hpp"
@@ -189,83 +190,121 @@ Vec<D> periodic_difference(const Grid<D>& grid, const Vec<D>& x, const Vec<D>& x
 }
 
 /// A position for the minimum-image differences of a body's points (periodic axes): its first
-/// point; `across_ranks`: along each axis the least of the ranks' first points' coordinates (a
-/// coordinate of one of its points: the same reference on every rank). Not finite when the body
-/// has no points.
+/// point on this rank; not finite when it has none here. (A decomposed run's reference is the
+/// same on every rank: along each axis the least of the ranks' first points' coordinates, a
+/// coordinate of one of the body's points. The step and the run's measures take that minimum.)
 template <class G>
-Vec<G::dim> body_reference(const Body<G>& body, bool across_ranks) {
-  Vec<G::dim> x0 = body.size() > 0 ? body.x_m[0] : Vec<G::dim>::Constant(INFINITY);
-  if (across_ranks) comm::min({x0.data(), static_cast<std::size_t>(G::dim)});
-  return x0;
+Vec<G::dim> body_reference(const Body<G>& body) {
+  return body.size() > 0 ? body.x_m[0] : Vec<G::dim>::Constant(INFINITY);
 }
 
-/// Mean angular velocity, centre and inertia of a body in the plane of the first and last axes
-/// (see Motor), positions unwrapped about body_reference on periodic axes (`grid`: the global
-/// grid); sums over every rank's points when `across_ranks`. `centre`, `velocity`: the centre of
-/// mass and the mean velocity (every component).
+/// The moments of a body's points for its angular state (see Motor) in the plane of the first and
+/// last axes, positions unwrapped about the reference x0 on periodic axes, in two stages: the
+/// second reads the first's centre and mean velocity. Each stage adds this rank's share of a sum
+/// over the body's points; a decomposed run completes a stage over the ranks before the next one.
 template <class G>
-void angular_state(const Body<G>& body, const Grid<G::dim>& grid, bool across_ranks, double& omega, double& inertia,
-                   Vec<G::dim>& centre, Vec<G::ncomp>& velocity) {
-  constexpr int D = G::dim, NC = G::ncomp, a = 0, b = D - 1;
-  static_assert(D == NC, "angular_state: plane strain and 3D (not axisymmetric)");
-  const std::int64_t np = body.size();
-  omega = inertia = 0.0;
-  centre.setZero();
-  velocity.setZero();
-  const Vec<D> x0 = body_reference(body, across_ranks);
-  if (!std::isfinite(x0[0])) return;       // no points
-  std::array<double, 1 + D + NC> first{};  // M, Σ m (x − x0), Σ m v
-  for (std::int64_t p = 0; p < np; ++p) {
-    const double m = body.mass_kg[p];
-    const Vec<D> d = m * periodic_difference<D>(grid, body.x_m[p], x0);
-    const Vec<NC> mv = m * body.v_m_s[p];
-    first[0] += m;
-    for (int k = 0; k < D; ++k) first[1 + k] += d[k];
-    for (int k = 0; k < NC; ++k) first[1 + D + k] += mv[k];
+struct BodyMoments {
+  static constexpr int D = G::dim, NC = G::ncomp;
+  Vec<D> x0 = Vec<D>::Zero();              ///< the reference (the same on every rank)
+  std::array<double, 1 + D + NC> first{};  ///< M, Σ m (x − x0), Σ m v
+  std::array<double, 2> second{};          ///< Σ m r × u, Σ m |r|² in the plane (about the centre, mean velocity)
+  /// The centre of mass less x0, from the first stage.
+  Vec<D> centre_offset() const {
+    Vec<D> dc;
+    for (int k = 0; k < D; ++k) dc[k] = first[1 + k] / first[0];
+    return dc;
   }
-  if (across_ranks) comm::sum_ordered(first);
-  const double M = first[0];
-  Vec<D> dc;
-  for (int k = 0; k < D; ++k) dc[k] = first[1 + k] / M;
-  for (int k = 0; k < NC; ++k) velocity[k] = first[1 + D + k] / M;
-  std::array<double, 2> second{};  // Σ m r × u, Σ m |r|² in the plane
-  for (std::int64_t p = 0; p < np; ++p) {
-    const double m = body.mass_kg[p];
-    const Vec<D> r = periodic_difference<D>(grid, body.x_m[p], x0) - dc;
+  /// The mean velocity, from the first stage.
+  Vec<NC> mean_velocity() const {
+    Vec<NC> v;
+    for (int k = 0; k < NC; ++k) v[k] = first[1 + D + k] / first[0];
+    return v;
+  }
+};
+
+/// Stage 1 of BodyMoments: mass, first moment about x0 and momentum of this rank's points.
+template <class G>
+void add_first_moments(BodyMoments<G>& m, const Body<G>& body, const Grid<G::dim>& grid) {
+  constexpr int D = G::dim, NC = G::ncomp;
+  for (std::int64_t p = 0; p < body.size(); ++p) {
+    const double mp = body.mass_kg[p];
+    const Vec<D> d = mp * periodic_difference<D>(grid, body.x_m[p], m.x0);
+    const Vec<NC> mv = mp * body.v_m_s[p];
+    m.first[0] += mp;
+    for (int k = 0; k < D; ++k) m.first[1 + k] += d[k];
+    for (int k = 0; k < NC; ++k) m.first[1 + D + k] += mv[k];
+  }
+}
+
+/// Stage 2 of BodyMoments (the first complete): this rank's points' angular momentum and inertia
+/// in the plane about the centre of mass, relative to the mean velocity.
+template <class G>
+void add_second_moments(BodyMoments<G>& m, const Body<G>& body, const Grid<G::dim>& grid) {
+  constexpr int D = G::dim, NC = G::ncomp, a = 0, b = D - 1;
+  const Vec<D> dc = m.centre_offset();
+  const Vec<NC> velocity = m.mean_velocity();
+  for (std::int64_t p = 0; p < body.size(); ++p) {
+    const double mp = body.mass_kg[p];
+    const Vec<D> r = periodic_difference<D>(grid, body.x_m[p], m.x0) - dc;
     const Vec<NC> u = body.v_m_s[p] - velocity;
-    second[0] += m * (r[a] * u[b] - r[b] * u[a]);
-    second[1] += m * (r[a] * r[a] + r[b] * r[b]);
+    m.second[0] += mp * (r[a] * u[b] - r[b] * u[a]);
+    m.second[1] += mp * (r[a] * r[a] + r[b] * r[b]);
   }
-  if (across_ranks) comm::sum_ordered(second);
-  inertia = second[1];
-  omega = inertia > 0.0 ? second[0] / inertia : 0.0;
-  centre = x0 + dc;
-  grid.wrap(centre);
 }
 
-/// Apply one motor correction (see Motor) to its body before the step (`grid`: the global grid).
+/// Mean angular velocity, inertia, centre of mass and mean velocity (every component) of a body
+/// in the plane of the first and last axes (see Motor); all zero for a body without points.
 template <class G>
-void apply_motor(Motor<G>& motor, Body<G>& body, const Grid<G::dim>& grid, bool across_ranks, double dt_s) {
+struct AngularState {
+  double omega_rad_s = 0.0, inertia_kg_m2 = 0.0;
+  Vec<G::dim> centre_m = Vec<G::dim>::Zero();
+  Vec<G::ncomp> velocity_m_s = Vec<G::ncomp>::Zero();
+};
+
+/// The angular state from complete moments (`grid`: the global grid).
+template <class G>
+AngularState<G> angular_state(const BodyMoments<G>& m, const Grid<G::dim>& grid) {
+  static_assert(G::dim == G::ncomp, "angular_state: plane strain and 3D (not axisymmetric)");
+  AngularState<G> st;
+  st.velocity_m_s = m.mean_velocity();
+  st.inertia_kg_m2 = m.second[1];
+  st.omega_rad_s = st.inertia_kg_m2 > 0.0 ? m.second[0] / st.inertia_kg_m2 : 0.0;
+  st.centre_m = m.x0 + m.centre_offset();
+  grid.wrap(st.centre_m);
+  return st;
+}
+
+/// The angular state of a body from the points on this rank alone (a run on one rank).
+template <class G>
+AngularState<G> angular_state(const Body<G>& body, const Grid<G::dim>& grid) {
+  BodyMoments<G> m;
+  m.x0 = body_reference(body);
+  if (!std::isfinite(m.x0[0])) return {};  // no points
+  add_first_moments(m, body, grid);
+  add_second_moments(m, body, grid);
+  return angular_state(m, grid);
+}
+
+/// Apply one motor correction (see Motor) to its body before the step, from the body's angular
+/// state over all its points (`grid`: the global grid).
+template <class G>
+void apply_motor(Motor<G>& motor, Body<G>& body, const Grid<G::dim>& grid, const AngularState<G>& state, double dt_s) {
   constexpr int D = G::dim, NC = G::ncomp, a = 0, b = D - 1;
-  Vec<D> centre;
-  Vec<NC> V;
-  double omega = 0.0, inertia = 0.0;
-  angular_state(body, grid, across_ranks, omega, inertia, centre, V);
-  const double dw = motor.gain * (motor.omega_rad_s - omega);
+  const double dw = motor.gain * (motor.omega_rad_s - state.omega_rad_s);
   const std::int64_t np = body.size();
   Mat<NC, NC> dC = Mat<NC, NC>::Zero();
   dC(a, b) = -dw;
   dC(b, a) = dw;
   for (std::int64_t p = 0; p < np; ++p) {
-    const Vec<D> r = periodic_difference<D>(grid, body.x_m[p], centre);
+    const Vec<D> r = periodic_difference<D>(grid, body.x_m[p], state.centre_m);
     body.v_m_s[p][a] -= dw * r[b];
     body.v_m_s[p][b] += dw * r[a];
     body.C_1_s[p] += dC;
   }
-  motor.omega_measured_rad_s = omega;
-  motor.inertia_kg_m2 = inertia;
-  motor.centre_m = centre;
-  motor.torque_N_m = inertia * dw / dt_s;
+  motor.omega_measured_rad_s = state.omega_rad_s;
+  motor.inertia_kg_m2 = state.inertia_kg_m2;
+  motor.centre_m = state.centre_m;
+  motor.torque_N_m = state.inertia_kg_m2 * dw / dt_s;
 }
 
 /// Predicted velocity of a rigid body (its mass rm.mass_kg set by the caller, over every rank);
@@ -439,59 +478,93 @@ std::vector<double> contact_node_weights(const Grid<D>& grid, const BoundaryCond
 }
 }  // namespace detail
 
-/// A pair's sums of the step (its share of the nodes on this rank; `across_ranks`: completed over
-/// every rank with the same bits on each) into its outputs.
-template <class G>
-Vec<G::ncomp> finish_pair_sums(ContactPair<G>& pair, const Vec<G::ncomp>& J_body, const Vec<G::ncomp>& J_grains,
-                               int active, bool across_ranks, double dt_s) {
-  constexpr int NC = G::ncomp;
-  double sums[2 * NC + 1];
-  for (int k = 0; k < NC; ++k) {
-    sums[k] = J_body[k];
-    sums[NC + k] = J_grains[k];
-  }
-  sums[2 * NC] = active;
-  if (across_ranks) comm::sum_ordered(sums);
-  Vec<NC> J = Eigen::Map<const Vec<NC>>(sums);
-  const Vec<NC> Jg = Eigen::Map<const Vec<NC>>(sums + NC);
-  pair.active_nodes = static_cast<int>(sums[2 * NC]);
-  pair.force_N = J / dt_s;
-  pair.force_on_grains_N = Jg / dt_s;
-  pair.impulse_sum_N_s += J;
-  return J;
-}
-
 /// Volume of node i's control volume h^D (per radian: h² r_i) for the overlap test.
 template <class G>
 double node_measure(const Grid<G::dim>& grid, int i) {
   return G::measure(grid.node_position(i), grid.cell_volume());
 }
 
-/// Resolve one contact pair at every node (docs/contact.md): impulses applied to the nodal velocities
-/// of the grains, the fluid and a deformable solid (a rigid one only accumulates them), summed
-/// with the node weights into pair.force_N. Serial over nodes (deterministic sums; the solid
-/// occupies few nodes). Returns the total impulse on the solid (over every rank: across_ranks).
+/// One contact pair's nodes in a step: the solid's and the mixture's nodal fields and the arrays
+/// of the step's contact (node weights, the mixture's nodal volume, the nodes' control volumes,
+/// the mixture's mass gradient with the combined normal, else null).
 template <class G>
-Vec<G::ncomp> resolve_contact(ContactPair<G>& pair, const RigidMotion<G>& rm, GridField<G>& solid, GridField<G>* grains,
-                              GridField<G>* fluid, const std::vector<double>& weight, const double* mixture_volume,
-                              const std::vector<double>& node_volume, const Vec<G::dim>* mixture_gradient,
-                              bool across_ranks, double dt_s) {
+struct ContactNodes {
+  ContactPair<G>& pair;
+  GridField<G>& solid;
+  GridField<G>* grains;
+  GridField<G>* fluid;
+  const std::vector<double>& weight;
+  const double* mixture_volume;
+  const std::vector<double>& node_volume;
+  const Vec<G::dim>* mixture_gradient;
+
+  /// Whether node i is a contact candidate (see the header: the solid and a mixture phase have
+  /// mass there, their nodal volumes overlap, the normal is defined), and its normal n.
+  bool candidate(int i, Vec<G::ncomp>& n) const {
+    if (!(solid.mass_kg[i] > 0.0) || weight[i] == 0.0) return false;
+    const double ms = grains ? grains->mass_kg[i] : 0.0, mf = fluid ? fluid->mass_kg[i] : 0.0;
+    if (!(ms > 0.0) && !(mf > 0.0)) return false;
+    if (pair.overlap_threshold > 0.0 && pair.volume_m3[i] + mixture_volume[i] < pair.overlap_threshold * node_volume[i])
+      return false;  // both have mass, but their smoothed volumes leave a gap: not touching
+    return contact_normal(pair, mixture_gradient, i, n);
+  }
+};
+
+/// A pair's sums of one step over the nodes, weighted by the node weights: this rank's share
+/// (decomposed runs: its owned nodes), which the step completes over the ranks before
+/// finish_pair reads it. The impulse on the solid, the part of its reaction on the grains, and the
+/// count of nodes where an impulse acted.
+template <class G>
+struct PairSums {
+  static constexpr int NC = G::ncomp;
+  static constexpr std::size_t size = 2 * NC + 1;
+  std::array<double, size> share{};  ///< J_body, J_grains, active nodes
+  PairSums(const Vec<NC>& J_body, const Vec<NC>& J_grains, int active) {
+    for (int k = 0; k < NC; ++k) {
+      share[k] = J_body[k];
+      share[NC + k] = J_grains[k];
+    }
+    share[2 * NC] = active;
+  }
+  explicit PairSums(const double* values) { std::copy_n(values, size, share.begin()); }
+  Vec<NC> body_impulse() const { return Eigen::Map<const Vec<NC>>(share.data()); }
+  Vec<NC> grains_impulse() const { return Eigen::Map<const Vec<NC>>(share.data() + NC); }
+  int active_nodes() const { return static_cast<int>(share[2 * NC]); }
+};
+
+/// A pair's complete sums of the step into its outputs (force, the grains' part, active nodes, the
+/// impulse sum). Returns the impulse on the solid.
+template <class G>
+Vec<G::ncomp> finish_pair(ContactPair<G>& pair, const PairSums<G>& sums, double dt_s) {
+  Vec<G::ncomp> J = sums.body_impulse();
+  pair.active_nodes = sums.active_nodes();
+  pair.force_N = J / dt_s;
+  pair.force_on_grains_N = sums.grains_impulse() / dt_s;
+  pair.impulse_sum_N_s += J;
+  return J;
+}
+
+/// Resolve one contact pair at every node (docs/contact.md): impulses applied to the nodal velocities
+/// of the grains, the fluid and a deformable solid (a rigid one only accumulates them). Serial over
+/// nodes (deterministic sums; the solid occupies few nodes). Returns this rank's share of the
+/// pair's sums.
+template <class G>
+PairSums<G> resolve_contact(const ContactNodes<G>& nodes, const RigidMotion<G>& rm) {
   constexpr int NC = G::ncomp;
+  GridField<G>& solid = nodes.solid;
+  GridField<G>* grains = nodes.grains;
+  GridField<G>* fluid = nodes.fluid;
   Vec<NC> J_body = Vec<NC>::Zero(), J_grains = Vec<NC>::Zero();
   int active = 0;
   const bool prescribed = rm.kind == BodyMotion::Prescribed, rigid = rm.rigid();
-  const double mu = pair.friction_coefficient;
+  const double mu = nodes.pair.friction_coefficient;
   const Vec<NC> zero = Vec<NC>::Zero();
   const int nn = solid.nodes();
   for (int i = 0; i < nn; ++i) {
-    const double mb = solid.mass_kg[i];
-    if (!(mb > 0.0) || weight[i] == 0.0) continue;
-    const double ms = grains ? grains->mass_kg[i] : 0.0, mf = fluid ? fluid->mass_kg[i] : 0.0;
-    if (!(ms > 0.0) && !(mf > 0.0)) continue;
-    if (pair.overlap_threshold > 0.0 && pair.volume_m3[i] + mixture_volume[i] < pair.overlap_threshold * node_volume[i])
-      continue;  // both have mass, but their smoothed volumes leave a gap: not touching
     Vec<NC> n;
-    if (!contact_normal(pair, mixture_gradient, i, n)) continue;
+    if (!nodes.candidate(i, n)) continue;
+    const double mb = solid.mass_kg[i];
+    const double ms = grains ? grains->mass_kg[i] : 0.0, mf = fluid ? fluid->mass_kg[i] : 0.0;
     Vec<NC> Js, Jf;
     if (!contact_impulses<NC>(n, prescribed ? INFINITY : mb, solid.velocity[i], ms,
                               ms > 0.0 ? grains->velocity[i] : zero, mf, mf > 0.0 ? fluid->velocity[i] : zero, mu, Js,
@@ -501,10 +574,10 @@ Vec<G::ncomp> resolve_contact(ContactPair<G>& pair, const RigidMotion<G>& rm, Gr
     if (ms > 0.0) grains->velocity[i] += Js / ms;
     if (mf > 0.0) fluid->velocity[i] += Jf / mf;
     if (!rigid) solid.velocity[i] -= (Js + Jf) / mb;
-    J_body -= weight[i] * (Js + Jf);
-    J_grains += weight[i] * Js;
+    J_body -= nodes.weight[i] * (Js + Jf);
+    J_grains += nodes.weight[i] * Js;
   }
-  return finish_pair_sums(pair, J_body, J_grains, active, across_ranks, dt_s);
+  return {J_body, J_grains, active};
 }
 
 /// Contact of a *free rigid* body with the mixture, solved for the body as a whole (docs/contact.md, in
@@ -515,79 +588,84 @@ Vec<G::ncomp> resolve_contact(ContactPair<G>& pair, const RigidMotion<G>& rm, Gr
 /// rule with the whole body as the third body), and V follows from momentum:
 ///   (M 1 + Σ w_i m_k,i n_i n_iᵀ) V = M V* + Σ w_i m_k,i (v_k,i·n_i) n_i   (free components),
 /// with the active set (pairs with V·n_i > v_k,i·n_i, i.e. J ≥ 0) found by fixed-point iteration
-/// (≤ 20 passes; it settles in 1–3). Then Coulomb friction on the grains with the body as the
-/// infinite-mass partner, J_t = min(μ J_n, m_s |w_t|), its reaction summed into V. Momentum is
-/// conserved exactly (each phase impulse is matched by the body's). Returns the body impulse.
-/// `across_ranks`: the node sums of the system and of the impulses over every rank (each rank's
-/// owned nodes), so that every rank solves the same system and gets the same V.
+/// (≤ kRigidContactPasses passes; it settles in 1–3; the step runs it: mpm/phases/contact.hpp).
+/// Then Coulomb friction on the grains with the body as the infinite-mass partner,
+/// J_t = min(μ J_n, m_s |w_t|), its reaction summed into V (apply_rigid_impulses). Momentum is
+/// conserved exactly (each phase impulse is matched by the body's).
+constexpr int kRigidContactPasses = 20;
+
+/// The system (A, b) for V of one pass, A = M 1 + Σ w m n nᵀ and b = M V* + Σ w m (v·n) n: the
+/// body's terms (body_terms) and the nodes' (add_rigid_system, this rank's share), stored as one
+/// array for the ranks' completion.
 template <class G>
-Vec<G::ncomp> resolve_rigid_contact(ContactPair<G>& pair, RigidMotion<G>& rm, const GridField<G>& solid,
-                                    GridField<G>* grains, GridField<G>* fluid, const std::vector<double>& weight,
-                                    const double* mixture_volume, const std::vector<double>& node_volume,
-                                    const Vec<G::dim>* mixture_gradient, bool across_ranks, double dt_s) {
-  constexpr int NC = G::ncomp;
-  const int nn = solid.nodes();
-  const double M = rm.mass_kg;
-  const Vec<NC> Vstar = rm.velocity_m_s;  // V* = V + Δt g (set by the caller)
-  auto normal_at = [&](int i, Vec<NC>& n) -> bool {
-    const double mb = solid.mass_kg[i];
-    if (!(mb > 0.0) || weight[i] == 0.0) return false;
-    const double ms = grains ? grains->mass_kg[i] : 0.0, mf = fluid ? fluid->mass_kg[i] : 0.0;
-    if (!(ms > 0.0) && !(mf > 0.0)) return false;
-    if (pair.overlap_threshold > 0.0 && pair.volume_m3[i] + mixture_volume[i] < pair.overlap_threshold * node_volume[i])
-      return false;
-    return contact_normal(pair, mixture_gradient, i, n);
-  };
-  // Active-set iteration for V.
-  Vec<NC> V = Vstar;
-  for (int it = 0; it < 20; ++it) {
-    // (across ranks: the nodes' terms alone first, summed over the ranks, then the body's)
-    Mat<NC, NC> A = across_ranks ? Mat<NC, NC>::Zero() : Mat<NC, NC>(M * Mat<NC, NC>::Identity());
-    Vec<NC> b = across_ranks ? Vec<NC>::Zero() : Vec<NC>(M * Vstar);
-    for (int i = 0; i < nn; ++i) {
-      Vec<NC> n;
-      if (!normal_at(i, n)) continue;
-      const double vbn = V.dot(n);
-      for (GridField<G>* ph : {grains, fluid}) {
-        if (!ph || !(ph->mass_kg[i] > 0.0)) continue;
-        const double vkn = ph->velocity[i].dot(n);
-        if (!(vkn < vbn)) continue;
-        const double wm = weight[i] * ph->mass_kg[i];
-        A += wm * (n * n.transpose());
-        b += (wm * vkn) * n;
-      }
-    }
-    if (across_ranks) {
-      double sums[NC * NC + NC];
-      Eigen::Map<Mat<NC, NC>> sum_A(sums);
-      Eigen::Map<Vec<NC>> sum_b(sums + NC * NC);
-      sum_A = A;
-      sum_b = b;
-      comm::sum_ordered(sums);
-      A = M * Mat<NC, NC>::Identity() + sum_A;
-      b = M * Vstar + sum_b;
-    }
-    for (int c = 0; c < NC; ++c) {  // held components: V_c = V*_c
-      if (rm.free_mask[c] != 0.0) continue;
-      A.row(c).setZero();
-      A(c, c) = 1.0;
-      b[c] = Vstar[c];
-    }
-    const Vec<NC> V_new = A.partialPivLu().solve(b);
-    const bool settled = (V_new - V).norm() <= 1e-14 * (1.0 + V_new.norm());
-    V = V_new;
-    if (settled && it > 0) break;
+struct RigidSystem {
+  static constexpr int NC = G::ncomp;
+  std::array<double, NC * NC + NC> share{};
+  Eigen::Map<Mat<NC, NC>> A() { return Eigen::Map<Mat<NC, NC>>(share.data()); }
+  Eigen::Map<Vec<NC>> b() { return Eigen::Map<Vec<NC>>(share.data() + NC * NC); }
+  /// The body's terms alone: M 1 and M V*.
+  static RigidSystem body_terms(double M, const Vec<NC>& Vstar) {
+    RigidSystem s;
+    s.A() = M * Mat<NC, NC>::Identity();
+    s.b() = M * Vstar;
+    return s;
   }
-  // Apply the normal impulses with the final V, then friction (grains) against V.
-  const double mu = pair.friction_coefficient;
-  Vec<NC> J_body = Vec<NC>::Zero(), J_grains = Vec<NC>::Zero();
-  int active = 0;
+};
+
+/// Adds this rank's nodes' terms of the rigid body's normal system at the velocity V: every phase
+/// that approaches the body at a candidate node (v_k·n < V·n) with its weighted mass.
+template <class G>
+void add_rigid_system(const ContactNodes<G>& nodes, const Vec<G::ncomp>& V, RigidSystem<G>& sys) {
+  constexpr int NC = G::ncomp;
+  auto A = sys.A();
+  auto b = sys.b();
+  const int nn = nodes.solid.nodes();
   for (int i = 0; i < nn; ++i) {
     Vec<NC> n;
-    if (!normal_at(i, n)) continue;
+    if (!nodes.candidate(i, n)) continue;
+    const double vbn = V.dot(n);
+    for (GridField<G>* ph : {nodes.grains, nodes.fluid}) {
+      if (!ph || !(ph->mass_kg[i] > 0.0)) continue;
+      const double vkn = ph->velocity[i].dot(n);
+      if (!(vkn < vbn)) continue;
+      const double wm = nodes.weight[i] * ph->mass_kg[i];
+      A += wm * (n * n.transpose());
+      b += (wm * vkn) * n;
+    }
+  }
+}
+
+/// V from a complete system, the held components (free_mask 0) kept at V*.
+template <class G>
+Vec<G::ncomp> solve_rigid_system(RigidSystem<G> sys, const RigidMotion<G>& rm, const Vec<G::ncomp>& Vstar) {
+  constexpr int NC = G::ncomp;
+  Mat<NC, NC> A = sys.A();
+  Vec<NC> b = sys.b();
+  for (int c = 0; c < NC; ++c) {
+    if (rm.free_mask[c] != 0.0) continue;
+    A.row(c).setZero();
+    A(c, c) = 1.0;
+    b[c] = Vstar[c];
+  }
+  return A.partialPivLu().solve(b);
+}
+
+/// The rigid contact's impulses with the body's final velocity V: every approaching phase at every
+/// candidate node brought to V·n, then friction on the grains against V. Returns this rank's share
+/// of the pair's sums.
+template <class G>
+PairSums<G> apply_rigid_impulses(const ContactNodes<G>& nodes, const Vec<G::ncomp>& V) {
+  constexpr int NC = G::ncomp;
+  const double mu = nodes.pair.friction_coefficient;
+  Vec<NC> J_body = Vec<NC>::Zero(), J_grains = Vec<NC>::Zero();
+  int active = 0;
+  const int nn = nodes.solid.nodes();
+  for (int i = 0; i < nn; ++i) {
+    Vec<NC> n;
+    if (!nodes.candidate(i, n)) continue;
     const double vbn = V.dot(n);
     bool touched = false;
-    for (GridField<G>* ph : {grains, fluid}) {
+    for (GridField<G>* ph : {nodes.grains, nodes.fluid}) {
       if (!ph || !(ph->mass_kg[i] > 0.0)) continue;
       const double m = ph->mass_kg[i];
       Vec<NC>& v = ph->velocity[i];
@@ -595,19 +673,19 @@ Vec<G::ncomp> resolve_rigid_contact(ContactPair<G>& pair, RigidMotion<G>& rm, co
       if (!(vkn < vbn)) continue;
       touched = true;
       Vec<NC> J = (m * (vbn - vkn)) * n;
-      if (ph == grains && mu > 0.0) {
+      if (ph == nodes.grains && mu > 0.0) {
         Vec<NC> w = v + J / m - V;
         w -= w.dot(n) * n;
         const double wt = w.norm();
         if (wt > 0.0) J -= (std::min(mu * (vbn - vkn) * m, m * wt) / wt) * w;
       }
       v += J / m;
-      J_body -= weight[i] * J;
-      if (ph == grains) J_grains += weight[i] * J;
+      J_body -= nodes.weight[i] * J;
+      if (ph == nodes.grains) J_grains += nodes.weight[i] * J;
     }
     active += touched ? 1 : 0;
   }
-  return finish_pair_sums(pair, J_body, J_grains, active, across_ranks, dt_s);
+  return {J_body, J_grains, active};
 }
 
 /// Lattice spacing of a point of a lattice body, (V_p/measure(x_p, 1))^(1/D) (plane: √V_p;

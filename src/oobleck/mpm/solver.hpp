@@ -101,9 +101,13 @@ class Solver {
   }
   RigidMotion<G>& rigid_motion(int b) { return s_.rigid[b]; }
   /// Contact between solid body b and the mixture (its grains and/or fluid body), Coulomb
-  /// coefficient μ between solid and grains (docs/contact.md). Returns the pair index.
+  /// coefficient μ between solid and grains (docs/contact.md). Returns the pair index. One pair
+  /// per solid (the step completes every pair's sums after the last pair, then moves the bodies).
   int add_contact(int b, double friction_coefficient) {
     check_solid(b, "contact");
+    for (const auto& c : s_.contacts)
+      if (c.solid == b)
+        throw InputError(fmt::format("mpm: contact: body '{}' has a contact pair already", s_.bodies[b]->name));
     if (!(friction_coefficient >= 0.0))
       throw InputError(fmt::format("mpm: friction coefficient must be >= 0, got {}", friction_coefficient));
     s_.contacts.emplace_back();

@@ -113,6 +113,7 @@ struct SolverState {
   std::vector<Vec<D>> mixture_gradient;   ///< nodal mixture mass gradient (combined normals)
   bool mixture_volume_scattered = false;  ///< mixture_volume holds this step's grains volume
   ContactBox<D> solids_box;               ///< the mixture's points near the contact solids (this step)
+  std::vector<double> pair_sums;          ///< every pair's PairSums share, pair after pair (this step)
   std::vector<ShapeCache<D>> caches;
   std::vector<std::int64_t> non_finite_kinematics;  ///< per body, from the last G2P
   std::vector<GridField<G>> fields;

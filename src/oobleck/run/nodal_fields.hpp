@@ -21,15 +21,16 @@
 namespace oobleck::run {
 
 /// Centre of mass of body b, periodic axes unwrapped about its first point (then wrapped);
-/// decomposed runs: over every rank's points, about a reference every rank shares
-/// (mpm::body_reference). Zero for a body without points.
+/// decomposed runs: over every rank's points, about a reference every rank shares (the least of
+/// the ranks' mpm::body_reference along each axis). Zero for a body without points.
 template <class G>
 mpm::Vec<G::dim> centre_of_mass(mpm::Solver<G>& solver, int b) {
   constexpr int D = G::dim;
   const mpm::Body<G>& body = solver.body(b);
   const bool across = solver.decomposition() != nullptr;
   const mpm::Grid<D>& grid = solver.global_grid();
-  const mpm::Vec<D> x0 = mpm::body_reference(body, across);
+  mpm::Vec<D> x0 = mpm::body_reference(body);
+  if (across) comm::min({x0.data(), static_cast<std::size_t>(D)});
   if (!std::isfinite(x0[0])) return mpm::Vec<D>::Zero();
   mpm::Vec<D> s = mpm::Vec<D>::Zero();
   double M = 0.0;

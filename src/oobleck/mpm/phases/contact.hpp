@@ -4,9 +4,13 @@
 // solids), part 2 beside the grid pass (the mass gradients' scatter), part 3 after it (phase 4:
 // the impulses and the rigid bodies' velocities) and part 4 after the points moved (phase 8: the
 // mixture's points out of free rigid bodies). step.hpp calls them and completes contact's nodal
-// sums on their owners (HaloRule::sum_before_contact) between parts 2 and 3.
+// sums on their owners (HaloRule::sum_before_contact) between parts 2 and 3. The kernels return
+// this rank's share of each whole-body sum; these phases complete the shares over the ranks
+// (`complete`, `shared_reference`), each where the step needs it.
 #include <algorithm>
 #include <cmath>
+#include <span>
+#include <cstddef>
 #include <type_traits>
 
 #include "oobleck/core/comm.hpp"
@@ -15,11 +19,43 @@
 
 namespace oobleck::mpm::phases {
 
-/// Phase 1: the velocity-level motors of driven bodies (plane strain and 3D).
+/// Completes this rank's share of a sum over the ranks in place (decomposed runs; the same bits on
+/// every rank: comm::sum_ordered); a run on one rank has the whole sum already.
+template <class G>
+inline void complete(const SolverState<G>& s, std::span<double> share) {
+  if (s.dec) comm::sum_ordered(share);
+}
+
+/// Body b's reference point for minimum-image differences (contact.hpp body_reference), the same
+/// on every rank: decomposed, the least over the ranks along each axis.
+template <class G>
+inline Vec<G::dim> shared_reference(const SolverState<G>& s, int b) {
+  Vec<G::dim> x0 = body_reference(*s.bodies[b]);
+  if (s.dec) comm::min({x0.data(), static_cast<std::size_t>(G::dim)});
+  return x0;
+}
+
+/// Phase 1: the velocity-level motors of driven bodies (plane strain and 3D), each from its body's
+/// angular state over every rank's points (the two stages of moments completed in turn).
 template <class G>
 inline void apply_motors(SolverState<G>& s) {
-  if constexpr (!std::is_same_v<G, Axisymmetric>)
-    for (auto& m : s.motors) apply_motor(m, *s.bodies[m.body], s.global_grid(), s.dec != nullptr, s.opt.dt_s);
+  if constexpr (!std::is_same_v<G, Axisymmetric>) {
+    const Grid<G::dim>& grid = s.global_grid();
+    for (auto& m : s.motors) {
+      Body<G>& body = *s.bodies[m.body];
+      BodyMoments<G> moments;
+      moments.x0 = shared_reference(s, m.body);
+      AngularState<G> state;
+      if (std::isfinite(moments.x0[0])) {  // (else no rank has points of the body)
+        add_first_moments(moments, body, grid);
+        complete(s, moments.first);
+        add_second_moments(moments, body, grid);
+        complete(s, moments.second);
+        state = angular_state(moments, grid);
+      }
+      apply_motor(m, body, grid, state, s.opt.dt_s);
+    }
+  }
 }
 
 /// The box around every contact solid's points (over every rank), grown by two kernel widths.
@@ -29,7 +65,7 @@ inline ContactBox<G::dim> box_around_contact_solids(const SolverState<G>& s) {
   const Grid<D>& grid = s.global_grid();
   Vec<D> ref = Vec<D>::Constant(INFINITY);  // the first solid's reference point (every rank's)
   for (const auto& c : s.contacts) {
-    ref = body_reference(*s.bodies[c.solid], s.dec != nullptr);
+    ref = shared_reference(s, c.solid);
     if (std::isfinite(ref[0])) break;
   }
   ContactBox<D> box;
@@ -66,7 +102,7 @@ inline void prepare_rigid_and_contact(SolverState<G>& s) {
     if (!s.rigid[b].rigid()) continue;
     double M = 0.0;
     for (double m : s.bodies[b]->mass_kg) M += m;
-    if (s.dec) comm::sum_ordered({&M, 1});
+    complete(s, {&M, 1});
     s.rigid[b].mass_kg = M;
   }
   if (s.contacts.empty()) return;
@@ -119,6 +155,33 @@ inline void scatter_contact_gradients(SolverState<G>& s) {
     scatter_mass_gradient_and_volume<G, K>(*s.bodies[c.solid], s.caches[c.solid], &c.mass_gradient, c.volume_m3);
 }
 
+/// A free rigid body's velocity V from its contact (the model: contact.hpp, kRigidContactPasses):
+/// the fixed-point iteration on the active set, each pass's normal system completed over the
+/// ranks before it is solved (one rank: the body's terms first, then the nodes'; decomposed: the
+/// nodes' terms over every rank, then the body's).
+template <class G>
+inline Vec<G::ncomp> rigid_contact_velocity(const SolverState<G>& s, const ContactNodes<G>& nodes,
+                                            const RigidMotion<G>& rm) {
+  constexpr int NC = G::ncomp;
+  const double M = rm.mass_kg;
+  const Vec<NC> Vstar = rm.velocity_m_s;  // V* = V + Δt g (resolve_contacts)
+  Vec<NC> V = Vstar;
+  for (int it = 0; it < kRigidContactPasses; ++it) {
+    RigidSystem<G> sys = s.dec ? RigidSystem<G>{} : RigidSystem<G>::body_terms(M, Vstar);
+    add_rigid_system(nodes, V, sys);
+    if (s.dec) {
+      complete(s, sys.share);
+      sys.A() = M * Mat<NC, NC>::Identity() + sys.A();
+      sys.b() = M * Vstar + sys.b();
+    }
+    const Vec<NC> V_new = solve_rigid_system(sys, rm, Vstar);
+    const bool settled = (V_new - V).norm() <= 1e-14 * (1.0 + V_new.norm());
+    V = V_new;
+    if (settled && it > 0) break;
+  }
+  return V;
+}
+
 /// Phase 4, contact part 3 (after the grid pass; decomposed: with part 2's sums completed on
 /// their owners): every pair's impulses (docs/contact.md, contact.hpp), then the free rigid
 /// bodies' new velocity V = V + Δt g + (Σ impulses)/M on their free components.
@@ -143,18 +206,33 @@ inline void resolve_contacts(SolverState<G>& s) {
   }
   if (combined) fold_wall_gradient<D>(s.grid, s.bc, s.mixture_gradient);
   for (auto& rm : s.rigid) rm.velocity_m_s = rm.predicted_m_s;
-  const bool across_ranks = s.dec != nullptr;
-  for (auto& c : s.contacts) {
+  constexpr std::size_t n = PairSums<G>::size;
+  s.pair_sums.resize(s.contacts.size() * n);
+  for (std::size_t k = 0; k < s.contacts.size(); ++k) {
+    ContactPair<G>& c = s.contacts[k];
+    const RigidMotion<G>& rm = s.rigid[c.solid];
+    const ContactNodes<G> nodes{c,
+                                s.fields[c.solid],
+                                grains,
+                                fluid,
+                                s.contact_weight,
+                                mixture_volume,
+                                s.node_measure,
+                                c.combined_normal ? s.mixture_gradient.data() : nullptr};
+    const PairSums<G> share = rm.kind == BodyMotion::FreeRigid && rm.mass_kg > 0.0
+                                  ? apply_rigid_impulses(nodes, rigid_contact_velocity(s, nodes, rm))  // whole body
+                                  : resolve_contact(nodes, rm);  // deformable or prescribed: node by node
+    std::copy(share.share.begin(), share.share.end(), s.pair_sums.begin() + static_cast<std::ptrdiff_t>(k * n));
+  }
+  // Every pair's sums completed at once (one pair per solid: Solver::add_contact), then the free
+  // rigid bodies' velocities V = V* + (Σ impulses)/M on their free components.
+  complete(s, s.pair_sums);
+  for (std::size_t k = 0; k < s.contacts.size(); ++k) {
+    ContactPair<G>& c = s.contacts[k];
     RigidMotion<G>& rm = s.rigid[c.solid];
-    const Vec<D>* mix_grad = c.combined_normal ? s.mixture_gradient.data() : nullptr;
-    if (rm.kind == BodyMotion::FreeRigid && rm.mass_kg > 0.0) {  // whole-body solve
-      const Vec<NC> J = resolve_rigid_contact(c, rm, s.fields[c.solid], grains, fluid, s.contact_weight, mixture_volume,
-                                              s.node_measure, mix_grad, across_ranks, s.opt.dt_s);
+    const Vec<NC> J = finish_pair(c, PairSums<G>(s.pair_sums.data() + k * n), s.opt.dt_s);
+    if (rm.kind == BodyMotion::FreeRigid && rm.mass_kg > 0.0)
       rm.velocity_m_s += J.cwiseProduct(rm.free_mask) / rm.mass_kg;
-    } else {  // deformable or prescribed: node by node
-      resolve_contact(c, rm, s.fields[c.solid], grains, fluid, s.contact_weight, mixture_volume, s.node_measure,
-                      mix_grad, across_ranks, s.opt.dt_s);
-    }
   }
 }
 
