@@ -8,6 +8,7 @@
 #include <initializer_list>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -68,22 +69,22 @@ struct MaterialOverrides {
   }
 };
 
-/// A CSV's columns, each with its SI unit (nullptr: a text column). csv_head() gives the comment
-/// line "# units: name=unit, ..." (text columns left out; a parameter set in normalized units,
-/// the Singh presets, gives "normalized" for every dimensional column) and the header line.
-struct CsvColumn {
-  const char* name;
-  const char* unit;
-};
-std::string csv_head(std::initializer_list<CsvColumn> columns, const rheology::Preset& p) {
+/// A CSV's head for its columns, each with its SI unit (material::PointColumn; empty: a text
+/// column): the comment line "# units: name=unit, ..." (text columns left out; a parameter set in
+/// normalized units, the Singh presets, gives "normalized" for every dimensional column) and the
+/// header line.
+using CsvColumn = material::PointColumn;
+std::string csv_head(std::span<const CsvColumn> columns, const rheology::Preset& p) {
   std::vector<std::string> units, names;
   for (const auto& c : columns) {
     names.emplace_back(c.name);
-    if (c.unit == nullptr) continue;
-    const bool dimensionless = std::string_view(c.unit) == "1";
-    units.push_back(fmt::format("{}={}", c.name, p.units == "normalized" && !dimensionless ? "normalized" : c.unit));
+    if (c.unit.empty()) continue;
+    units.push_back(fmt::format("{}={}", c.name, p.units == "normalized" && c.unit != "1" ? "normalized" : c.unit));
   }
   return fmt::format("# units: {}\n{}\n", fmt::join(units, ", "), fmt::join(names, ","));
+}
+std::string csv_head(std::initializer_list<CsvColumn> columns, const rheology::Preset& p) {
+  return csv_head(std::span<const CsvColumn>(columns.begin(), columns.size()), p);
 }
 
 /// An option left at NaN (not given) as an empty optional.
@@ -169,7 +170,7 @@ void shear_command(CLI::App& point) {
                     {"sigma_xy", "Pa"},
                     {"f", "1"},
                     {"phi", "1"},
-                    {"regime", nullptr},
+                    {"regime", ""},
                     {"gamma_dot_p", "1/s"},
                     {"I_v", "1"},
                     {"I_m", "1"},
@@ -259,23 +260,15 @@ void relax_command(CLI::App& point) {
     const std::vector<material::RelaxResult> results = material::run_relax_sweep(base, in, hooks);
     io::OutputFile csv(o->out, "--out");
     auto& st = csv.stream();
-    st << csv_head({{"case", "1"},
-                    {"G", "Pa"},
-                    {"K_0", "1"},
-                    {"time", "s"},
-                    {"granular_shear_stress", "Pa"},
-                    {"granular_pressure", "Pa"},
-                    {"f", "1"},
-                    {"gamma_dot_p", "1/s"},
-                    {"regime", nullptr},
-                    {"ode_granular_shear_stress", "Pa"},
-                    {"ode_f", "1"}},
-                   base);
+    st << csv_head(material::relax_columns(), base);
     for (std::size_t c = 0; c < results.size(); ++c) {
       for (const auto& x : results[c].samples) {
-        st << fmt::format("{},{},{},{},{},{},{},{},{},{},{}\n", c, num(results[c].G), num(results[c].K_0), num(x.time),
-                          num(x.tau_bar), num(x.p), num(x.f), num(x.gamma_dot_p), material::regime_name(x.regime),
-                          num(x.ode_tau_bar), num(x.ode_f));
+        const auto row = material::relax_row(c, results[c], x);
+        std::vector<std::string> cells;
+        for (std::size_t k = 0; k < row.size(); ++k)
+          cells.push_back(material::relax_columns()[k].unit.empty() ? std::string(material::regime_name(x.regime))
+                                                                    : num(row[k]));
+        st << fmt::format("{}\n", fmt::join(cells, ","));
       }
     }
     csv.commit();

@@ -17,6 +17,7 @@
 #include "verdict.hpp"
 #include "oobleck/core/error.hpp"
 #include "oobleck/io/output_file.hpp"
+#include "oobleck/rheology/parameter_table.hpp"
 
 namespace oobleck::cli {
 namespace {
@@ -459,7 +460,10 @@ void wheel(Reproduction& r) {
   // SI ringing figure: the fast wheel to t = 1 s with the granular moduli G, K times 1, 10 and 100,
   // all three at the time step the stiffest needs (below its CFL limit), so that only the
   // stiffness changes. A run that fails (the instability growing into NaN) is a result too.
-  const double G = s[0]["parameters"]["G"].get<double>(), K = s[0]["parameters"]["K"].get<double>();
+  const rheology::Parameter& G_row = rheology::parameter(&rheology::GranularParams::G);
+  const rheology::Parameter& K_row = rheology::parameter(&rheology::GranularParams::K);
+  const double G = s[0]["parameters"][std::string(G_row.summary_key())].get<double>();
+  const double K = s[0]["parameters"][std::string(K_row.summary_key())].get<double>();
   const double dt = r.quick ? 4e-5 : 1e-5;
   std::vector<std::string> stiff, measured;
   std::vector<double> scatter;
@@ -467,8 +471,8 @@ void wheel(Reproduction& r) {
     const std::string name = fmt::format("wheel_stiff{}", m);
     try {
       r.oobleck(fmt::format("run {} --out {}/{} --quiet --set omega=10{}{} --set duration=1.0 --set time.dt={:g} "
-                            "--set G={:g} --set K={:g}",
-                            scene, r.out, name, t, q, dt, m * G, m * K),
+                            "--set material.granular.{}={:g} --set material.granular.{}={:g}",
+                            scene, r.out, name, t, q, dt, G_row.name, m * G, K_row.name, m * K),
                 fmt::format("SI pressure field, fast wheel with G and K x {}", m));
       const nlohmann::json sum = r.summary(name);
       const nlohmann::json& pooled = sum.at("pressure_scatter").at("pooled");

@@ -44,8 +44,7 @@ def point_shear(params, phi, *, shear_rate=None, shear_stress=None, duration, dt
     return df
 
 
-RELAX_COLUMNS = ("case", "G", "K_0", "time", "granular_shear_stress", "granular_pressure", "f", "gamma_dot_p",
-                 "regime", "ode_granular_shear_stress", "ode_f")
+RELAX_COLUMNS = _core.RELAX_COLUMNS  # (material::relax_columns)
 
 
 def point_relax(params, phi, *, shear_rate=None, shear_stress=None, duration, dt=None, samples=200, G=None, K0=None,

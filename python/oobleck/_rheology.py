@@ -8,8 +8,7 @@ from . import InputError, Params, _core
 from ._args import _frame, _integer, _number, _numbers, _pandas, _params
 
 
-FLOW_CURVE_COLUMNS = ("phi", "f", "shear_rate", "shear_stress", "granular_pressure", "granular_shear_stress",
-                      "viscosity", "eta_r", "shear_rate_dst")
+FLOW_CURVE_COLUMNS = _core.FLOW_CURVE_COLUMNS  # (rheology::kFlowCurveColumns)
 _flow_curve_index = None  # pandas.Index of FLOW_CURVE_COLUMNS, built on first use
 
 

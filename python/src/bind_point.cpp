@@ -103,28 +103,20 @@ py::dict point_relax(const rheology::Preset& base, double phi, std::optional<dou
     py::gil_scoped_release release;
     results = material::run_relax_sweep(base, in);
   }
-  std::vector<double> c[10];
+  const auto columns = material::relax_columns();
+  std::vector<std::vector<double>> c(columns.size());
   std::vector<std::string> regime;
   for (std::size_t k = 0; k < results.size(); ++k) {
     for (const auto& x : results[k].samples) {
-      const double v[10] = {static_cast<double>(k), results[k].G,  results[k].K_0, x.time, x.tau_bar, x.p, x.f,
-                            x.gamma_dot_p,          x.ode_tau_bar, x.ode_f};
-      for (int j = 0; j < 10; ++j) c[j].push_back(v[j]);
+      const auto row = material::relax_row(k, results[k], x);
+      for (std::size_t j = 0; j < columns.size(); ++j)
+        if (!columns[j].unit.empty()) c[j].push_back(row[j]);
       regime.emplace_back(material::regime_name(x.regime));
     }
   }
-  static const char* names[10] = {"case",
-                                  "G",
-                                  "K_0",
-                                  "time",
-                                  "granular_shear_stress",
-                                  "granular_pressure",
-                                  "f",
-                                  "gamma_dot_p",
-                                  "ode_granular_shear_stress",
-                                  "ode_f"};
   py::dict d;
-  for (int k = 0; k < 10; ++k) d[names[k]] = to_array(c[k]);
+  for (std::size_t j = 0; j < columns.size(); ++j)
+    if (!columns[j].unit.empty()) d[py::str(std::string(columns[j].name))] = to_array(c[j]);
   d["regime"] = regime;
   return d;
 }
@@ -132,6 +124,9 @@ py::dict point_relax(const rheology::Preset& base, double phi, std::optional<dou
 }  // namespace
 
 void bind_point(py::module_& m) {
+  py::list relax_columns;
+  for (const material::PointColumn& c : material::relax_columns()) relax_columns.append(py::str(std::string(c.name)));
+  m.attr("RELAX_COLUMNS") = py::tuple(relax_columns);
   m.def("point_shear", &point_shear, py::arg("params"), py::arg("phi"), py::arg("shear_rate"), py::arg("shear_stress"),
         py::arg("duration"), py::arg("dt"), py::arg("f0"), py::arg("samples"));
   m.def("point_relax", &point_relax, py::arg("params"), py::arg("phi"), py::arg("shear_rate"), py::arg("shear_stress"),

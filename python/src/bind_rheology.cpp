@@ -8,6 +8,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <tuple>
 #include <vector>
 
@@ -34,7 +35,7 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// The flow curves at one or several phi as one (9, rows) C-contiguous array, row k the k-th
-/// column of `rheology flow-curve` (rheology::kFlowCurveColumns; FLOW_CURVE_COLUMNS in Python):
+/// column of `rheology flow-curve` (rheology::kFlowCurveColumns, FLOW_CURVE_COLUMNS in Python):
 /// one allocation, filled in place by rheology::flow_curve_columns without the GIL (no copy after
 /// the sweep); the Python side views its rows as a dict or wraps it (transposed, no copy) as a
 /// DataFrame. `phi` is a float or a sequence of floats.
@@ -312,6 +313,9 @@ py::tuple rheometer_flow_curve(const std::string& path, const std::string& step)
 }  // namespace
 
 void bind_rheology(py::module_& m) {
+  py::list flow_curve_columns;
+  for (std::string_view name : rheology::kFlowCurveColumns) flow_curve_columns.append(py::str(std::string(name)));
+  m.attr("FLOW_CURVE_COLUMNS") = py::tuple(flow_curve_columns);
   m.def("flow_curve", &flow_curve, py::arg("params"), py::arg("phi"), py::arg("points"));
   m.def("shear_rate_dst", &shear_rate_dst, py::arg("params"), py::arg("phi"));
   m.def("structure", &structure, py::arg("params"), py::arg("points"));

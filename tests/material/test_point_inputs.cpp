@@ -5,6 +5,7 @@
 #include <cmath>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -188,4 +189,46 @@ TEST(PointInputs, RelaxSweepRunsKZeroOuterGInner) {
   ASSERT_EQ(base.size(), 1u);
   EXPECT_EQ(base[0].G, p.granular.G);
   EXPECT_EQ(base[0].K_0, p.granular.K_0);
+}
+
+TEST(PointInputs, RelaxColumnsHoldTheirQuantities) {
+  // Each named column of the relaxation table (the CLI's CSV and the Python dict) holds the
+  // quantity its name says, with its unit; the text column (regime) has no unit and no number.
+  material::RelaxResult r;
+  r.G = 1.5e5;
+  r.K_0 = 2.5;
+  material::RelaxSample x;
+  x.time = 0.125;
+  x.tau_bar = 11.0;
+  x.p = 12.0;
+  x.f = 0.3;
+  x.gamma_dot_p = 7.0;
+  x.ode_tau_bar = 10.5;
+  x.ode_f = 0.29;
+  const std::vector<std::pair<std::string, double>> expected = {{"case", 3.0},
+                                                                {"G", 1.5e5},
+                                                                {"K_0", 2.5},
+                                                                {"time", 0.125},
+                                                                {"granular_shear_stress", 11.0},
+                                                                {"granular_pressure", 12.0},
+                                                                {"f", 0.3},
+                                                                {"gamma_dot_p", 7.0},
+                                                                {"ode_granular_shear_stress", 10.5},
+                                                                {"ode_f", 0.29}};
+  const auto columns = material::relax_columns();
+  const auto row = material::relax_row(3, r, x);
+  ASSERT_EQ(columns.size(), row.size());
+  ASSERT_EQ(columns.size(), expected.size() + 1);
+  for (const auto& [name, value] : expected) {
+    std::size_t k = 0;
+    while (k < columns.size() && columns[k].name != name) ++k;
+    ASSERT_LT(k, columns.size()) << name;
+    EXPECT_EQ(row[k], value) << name;
+    EXPECT_FALSE(columns[k].unit.empty()) << name;
+  }
+  EXPECT_EQ(columns[8].name, "regime");
+  EXPECT_TRUE(columns[8].unit.empty());
+  EXPECT_TRUE(std::isnan(row[8]));
+  EXPECT_EQ(columns[1].unit, "Pa");  // G
+  EXPECT_EQ(columns[2].unit, "1");   // K_0
 }

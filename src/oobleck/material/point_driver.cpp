@@ -10,6 +10,7 @@
 #include "oobleck/rheology/dilation.hpp"
 #include "oobleck/rheology/eta_b.hpp"
 #include "oobleck/rheology/flow_curve.hpp"
+#include "oobleck/rheology/parameter_table.hpp"
 #include "oobleck/rheology/f_max.hpp"
 #include "oobleck/rheology/viscosity.hpp"
 
@@ -467,6 +468,29 @@ RelaxOptions relax_options(const RelaxInput& in) {
   ro.dt = in.dt.value_or(0.0);
   ro.samples = in.samples;
   return ro;
+}
+
+std::span<const PointColumn> relax_columns() {
+  auto column = [](double rheology::GranularParams::*member) {
+    const rheology::Parameter& row = rheology::parameter(member);
+    return PointColumn{row.name, row.unit};
+  };
+  static const std::array<PointColumn, 11> columns = {PointColumn{"case", "1"},
+                                                      column(&rheology::GranularParams::G),
+                                                      column(&rheology::GranularParams::K_0),
+                                                      {"time", "s"},
+                                                      {"granular_shear_stress", "Pa"},
+                                                      {"granular_pressure", "Pa"},
+                                                      {"f", "1"},
+                                                      {"gamma_dot_p", "1/s"},
+                                                      {"regime", ""},
+                                                      {"ode_granular_shear_stress", "Pa"},
+                                                      {"ode_f", "1"}};
+  return columns;
+}
+
+std::array<double, 11> relax_row(std::size_t c, const RelaxResult& r, const RelaxSample& x) {
+  return {static_cast<double>(c), r.G, r.K_0, x.time, x.tau_bar, x.p, x.f, x.gamma_dot_p, NAN, x.ode_tau_bar, x.ode_f};
 }
 
 std::vector<RelaxResult> run_relax_sweep(const rheology::Preset& base, const RelaxInput& in,

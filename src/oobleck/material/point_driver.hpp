@@ -3,9 +3,13 @@
 // fixed volume, rate- or stress-controlled, and stress relaxation after cessation of steady shear
 // (the SI's method for G and K_0) beside the SI's reduced ODE, with the input checks and the
 // relaxation sweep over G and K_0 that `oobleck point` and oobleck.point_shear/point_relax share.
+#include <array>
 #include <cmath>
+#include <cstddef>
 #include <functional>
 #include <optional>
+#include <span>
+#include <string_view>
 #include <vector>
 
 #include "oobleck/material/granular.hpp"
@@ -164,6 +168,22 @@ struct RelaxSweepHooks {
 /// results in that order.
 std::vector<RelaxResult> run_relax_sweep(const rheology::Preset& base, const RelaxInput& in,
                                          const RelaxSweepHooks& hooks = {});
+
+/// One column of a point run's table (the CLI's CSV, the Python module's dict): its name and SI
+/// unit ("1": dimensionless; empty: a text column).
+struct PointColumn {
+  std::string_view name;
+  std::string_view unit;
+};
+
+/// The columns of a relaxation sweep's table, in order: case, G, K_0 (named and united as the
+/// parameter table has them), time, granular_shear_stress, granular_pressure, f, gamma_dot_p,
+/// regime (text), ode_granular_shear_stress, ode_f.
+std::span<const PointColumn> relax_columns();
+
+/// Sample x of case c (its result r) in relax_columns' order; the text column (regime) is NaN here
+/// (regime_name(x.regime) gives its text).
+std::array<double, 11> relax_row(std::size_t c, const RelaxResult& r, const RelaxSample& x);
 
 /// The SI's reduced relaxation ODE (docs/granular.md, "Notes on the SI"): d tau_bar/dt = -G gamma_dot^p,
 /// gamma_dot^p = tau_bar/(c(f) eta_0) with c(f) = mu_1 eta_n + (5/2) phi^2/(phi_m - phi) (E3–E5),

@@ -157,6 +157,13 @@ const Parameter& parameter(double SteadyParams::*member) {
   throw std::logic_error("a steady member with no row in the parameter table");
 }
 
+const Parameter& parameter(double GranularParams::*member) {
+  for (const Parameter& row : kTable) {
+    if (row.granular == member) return row;
+  }
+  throw std::logic_error("a granular member with no row in the parameter table");
+}
+
 double& value(Preset& p, const Parameter& row) {
   if (row.steady != nullptr) return p.steady.*row.steady;
   if (row.granular != nullptr) return p.granular.*row.granular;

@@ -50,6 +50,8 @@ struct Parameter {
   CurvesFit curves_fit = CurvesFit::never;
   /// summary.json's key where it differs from `name` (mu_c is written as "mu_1").
   std::string_view summary_name;
+  /// summary.json's key of the parameter: summary_name, else name.
+  std::string_view summary_key() const { return summary_name.empty() ? name : summary_name; }
   double SteadyParams::*steady = nullptr;      ///< the member (Section::Steady)
   double GranularParams::*granular = nullptr;  ///< the member (Section::Granular)
   double FluidParams::*fluid = nullptr;        ///< the member (Section::Fluid)
@@ -64,6 +66,8 @@ const Parameter& parameter(Section section, std::string_view name);
 
 /// The row of a steady member (&SteadyParams::a_0): its name where code knows the member.
 const Parameter& parameter(double SteadyParams::*member);
+/// The row of a granular member (&GranularParams::G).
+const Parameter& parameter(double GranularParams::*member);
 
 /// The member a steady or granular row names, in a preset (logic_error for a fluid row).
 double& value(Preset& p, const Parameter& row);

@@ -22,7 +22,7 @@ nlohmann::json parameters(const scene::SceneConfig& config, nlohmann::json& unit
   p["preset"] = config.material.name;
   put("phi", config.regions.front().phi, "1");
   for (const rheology::Parameter& row : rheology::parameter_table()) {
-    const std::string key(row.summary_name.empty() ? row.name : row.summary_name);
+    const std::string key(row.summary_key());
     const double v = row.section == rheology::Section::Fluid ? rheology::value(config.fluid, row)
                                                              : rheology::effective_value(config.material, row);
     put(key.c_str(), v, std::string(row.unit).c_str());
