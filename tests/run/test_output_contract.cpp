@@ -31,7 +31,9 @@ const std::string kSource = OOBLECK_SOURCE_DIR;
 void key_paths(const nlohmann::json& j, const std::string& prefix, std::set<std::string>& out) {
   if (j.is_object()) {
     for (const auto& [k, v] : j.items()) {
-      const std::string path = prefix.empty() ? k : prefix + "." + k;
+      std::string path = prefix;
+      if (!path.empty()) path += '.';
+      path += k;
       out.insert(path);
       key_paths(v, path, out);
     }
@@ -47,6 +49,7 @@ std::vector<std::string> contract_of(const fs::path& run_dir) {
   std::set<std::string> keys;
   key_paths(summary, "", keys);
   std::vector<std::string> lines;
+  lines.reserve(keys.size());
   for (const auto& k : keys) lines.push_back("summary " + k);
   std::ifstream cf(run_dir / "series.csv");
   std::string line;
